@@ -1,0 +1,40 @@
+# Helpers so that a core module, a tool or a test suite is one call (style.md §14).
+
+# Warnings for every skybake target.
+add_library(skybake_warnings INTERFACE)
+target_compile_options(skybake_warnings INTERFACE -Wall -Wextra -Wpedantic -Wshadow -Wno-unused-parameter)
+if(SKYBAKE_SANITIZE)
+  target_compile_options(skybake_warnings INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer)
+  target_link_options(skybake_warnings INTERFACE -fsanitize=address,undefined)
+endif()
+
+# skybake_add_core_module(NAME <module> DEPS <targets...>)
+# Builds tools/core/<module>/*.cpp into the static library skybake_<module>.
+function(skybake_add_core_module)
+  cmake_parse_arguments(ARG "" "NAME" "DEPS" ${ARGN})
+  file(GLOB _src CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/${ARG_NAME}/*.cpp)
+  add_library(skybake_${ARG_NAME} STATIC ${_src})
+  target_include_directories(skybake_${ARG_NAME} PUBLIC ${CMAKE_SOURCE_DIR}/tools/core ${CMAKE_BINARY_DIR}/generated)
+  target_link_libraries(skybake_${ARG_NAME} PUBLIC ${ARG_DEPS} PRIVATE skybake_warnings)
+endfunction()
+
+# skybake_add_tool(NAME <tool> [SOURCES ...] DEPS <core modules...>)
+# A tool is tools/<tool>/*.cpp (main.cpp plus the tool's own helpers).
+function(skybake_add_tool)
+  cmake_parse_arguments(ARG "" "NAME" "DEPS" ${ARGN})
+  file(GLOB _src CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
+  add_executable(${ARG_NAME} ${_src})
+  target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} skybake_warnings)
+endfunction()
+
+# skybake_add_test_suite(NAME <suite> DEPS <targets...>)
+# tests/<suite>/*_test.cpp -> one GoogleTest binary test_<suite>, registered per test case.
+function(skybake_add_test_suite)
+  cmake_parse_arguments(ARG "" "NAME" "DEPS" ${ARGN})
+  file(GLOB _src CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/${ARG_NAME}/*_test.cpp)
+  add_executable(test_${ARG_NAME} ${_src})
+  target_link_libraries(test_${ARG_NAME} PRIVATE ${ARG_DEPS} GTest::gtest_main skybake_warnings)
+  target_compile_definitions(test_${ARG_NAME} PRIVATE
+    SKYBAKE_SOURCE_DIR="${CMAKE_SOURCE_DIR}" SKYBAKE_BIN_DIR="${CMAKE_BINARY_DIR}/bin")
+  gtest_discover_tests(test_${ARG_NAME} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS unit)
+endfunction()

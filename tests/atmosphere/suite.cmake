@@ -1,0 +1,1 @@
+skybake_add_test_suite(NAME atmosphere DEPS skybake_atmosphere skybake_io)

@@ -1,0 +1,97 @@
+// Atomic write-if-changed, depfiles and deterministic EXR bytes.
+#include <gtest/gtest.h>
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <thread>
+
+#include "io/error.h"
+#include "io/exr.h"
+#include "io/fileio.h"
+
+namespace fs = std::filesystem;
+using namespace skybake;
+
+namespace {
+fs::path TempDir() {
+  fs::path d = fs::temp_directory_path() / ("skybake_io_test_" + std::to_string(::getpid()));
+  fs::create_directories(d);
+  return d;
+}
+}  // namespace
+
+TEST(FileIo, WriteIfChangedKeepsMtimeWhenEqual) {
+  fs::path p = TempDir() / "sub" / "a.bin";
+  EXPECT_TRUE(WriteFileIfChanged(p, "hello"));
+  auto t0 = fs::last_write_time(p);
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  EXPECT_FALSE(WriteFileIfChanged(p, "hello"));
+  EXPECT_EQ(fs::last_write_time(p), t0);
+  EXPECT_TRUE(WriteFileIfChanged(p, "hello!"));
+  EXPECT_EQ(ReadFileBytes(p), "hello!");
+  // No temporary files are left behind.
+  size_t n = 0;
+  for (auto& e : fs::directory_iterator(p.parent_path())) n += e.is_regular_file();
+  EXPECT_EQ(n, 1u);
+}
+
+TEST(FileIo, Depfile) {
+  fs::path d = TempDir() / "x.d";
+  WriteDepfile(d, "out dir/a.exr", {"in.yaml", "data/a b.csv"});
+  EXPECT_EQ(ReadFileBytes(d), "out\\ dir/a.exr: \\\n  in.yaml \\\n  data/a\\ b.csv\n");
+}
+
+TEST(FileIo, HashIsStable) {
+  EXPECT_EQ(HashBytes("skybake"), HashBytes("skybake"));
+  EXPECT_NE(HashBytes("skybake"), HashBytes("skybakf"));
+  EXPECT_EQ(HashBytes("").size(), 16u);
+}
+
+TEST(Exr, TableRoundTripWithProvenance) {
+  ExrTable t;
+  t.axes.push_back({"altitude", "m", "test axis", {0.0, 100.0, 250.0}});
+  t.axes.push_back({"wavelength", "nm", "second axis", {400.0, 500.0}});
+  t.channels = {"a", "b"};
+  t.channel_units = {"m^-3", "K"};
+  for (size_t i = 0; i < 6; ++i) {
+    t.values.push_back(static_cast<float>(i) * 1.5e20f);
+    t.values.push_back(static_cast<float>(i));
+  }
+  ExrImage img = TableToImage(t);
+  Provenance p;
+  p.tool = "test";
+  p.parameters = "x: 1\n";
+  SetProvenance(img, p);
+  img.chromaticities = XyzChromaticities();
+  std::string bytes = EncodeExr(img);
+  EXPECT_EQ(bytes, EncodeExr(img)) << "encoding must be deterministic";
+  ExrImage back = DecodeExr(bytes, "mem.exr");
+  EXPECT_EQ(back.strings.at("skybake.tool"), "test");
+  EXPECT_EQ(back.strings.at("skybake.parameters"), "x: 1\n");
+  ASSERT_TRUE(back.chromaticities.has_value());
+  EXPECT_FLOAT_EQ(back.chromaticities->white.x, 1.0f / 3.0f);
+  ExrTable t2 = ImageToTable(back, "mem.exr");
+  ASSERT_EQ(t2.axes.size(), 2u);
+  EXPECT_EQ(t2.axes[0].values, t.axes[0].values);
+  EXPECT_EQ(t2.axes[1].unit, "nm");
+  EXPECT_EQ(t2.channel_units, t.channel_units);
+  EXPECT_EQ(t2.values, t.values);
+}
+
+TEST(Exr, TruncatedAndGarbageFilesAreInputErrors) {
+  ExrImage img;
+  img.Resize(64, 64, {"R", "G", "B"});
+  for (size_t i = 0; i < img.pixels.size(); ++i) img.pixels[i] = static_cast<float>(i % 97) * 0.37f;
+  std::string bytes = EncodeExr(img);
+  EXPECT_THROW(DecodeExr(bytes.substr(0, bytes.size() / 2), "half.exr"), InputError);
+  EXPECT_THROW(DecodeExr("not an exr at all", "junk.exr"), InputError);
+  try {
+    ReadExr("/nonexistent.exr");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "/nonexistent.exr: cannot open file");
+  }
+}

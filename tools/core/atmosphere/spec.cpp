@@ -1,0 +1,193 @@
+#include "atmosphere/spec.h"
+
+#include <cmath>
+#include <set>
+
+#include <fmt/format.h>
+
+namespace skybake {
+
+std::vector<double> AtmosphereSpec::AltitudeGrid() const {
+  SKYBAKE_CHECK(planet.has_value() && grid.has_value());
+  std::vector<double> z;
+  const double top = planet->top_m, step = grid->altitude_step_m;
+  const size_t n = static_cast<size_t>(std::ceil(top / step - 1e-9));
+  for (size_t i = 0; i < n; ++i) z.push_back(static_cast<double>(i) * step);
+  z.push_back(top);
+  return z;
+}
+
+namespace {
+
+bool IsIdentifier(const std::string& s) {
+  if (s.empty() || !(std::islower(static_cast<unsigned char>(s[0])))) return false;
+  for (char c : s) {
+    if (!(std::islower(static_cast<unsigned char>(c)) || std::isdigit(static_cast<unsigned char>(c)) || c == '_'))
+      return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& default_name) {
+  AtmosphereSpec spec;
+  spec.file = doc.display_name();
+  YamlMap root = doc.RootMap();
+  spec.name = root.OptionalString("name", "a name").value_or(default_name);
+
+  if (std::optional<YamlMap> planet = root.OptionalMap("planet")) {
+    PlanetSpec p;
+    p.radius_m = planet->Number("radius_km", NumberSpec::Positive("km"), 6371.0) * 1e3;
+    p.top_m = planet->Number("top_km", NumberSpec::Positive("km"), 100.0) * 1e3;
+    planet->Finish();
+    spec.planet = p;
+  }
+  if (std::optional<YamlMap> observer = root.OptionalMap("observer")) {
+    spec.observer_altitude_m = observer->NumberOr("altitude_km", NumberSpec::NonNegative("km"), 0.0) * 1e3;
+    observer->Finish();
+  }
+  if (std::optional<YamlMap> grid = root.OptionalMap("grid")) {
+    GridSpec g;
+    g.altitude_step_m = grid->Number("altitude_step_m", NumberSpec::Range(1.0, 10000.0, "m"), 100.0);
+    grid->Finish();
+    spec.grid = g;
+  }
+  if (std::optional<YamlMap> air = root.OptionalMap("air")) {
+    AirSpec a;
+    if (std::optional<YamlNode> prof = air->Get("profile")) {
+      if (std::optional<ProfileSpec> p = ParseProfile(*prof, {"ussa1976", "exponential"})) a.profile = *p;
+    } else {
+      air->ErrorMissing("profile", "ussa1976 or {exponential: {...}}");
+    }
+    a.surface_number_density_m3 =
+        air->NumberOr("surface_number_density_m3", NumberSpec::Positive("m^-3"), a.surface_number_density_m3);
+    air->Finish();
+    spec.air = a;
+  }
+  if (std::optional<YamlMap> ozone = root.OptionalMap("ozone")) {
+    OzoneSpec o;
+    if (std::optional<YamlNode> prof = ozone->Get("profile")) {
+      if (std::optional<ProfileSpec> p = ParseProfile(*prof, {"table", "tent", "exponential"})) o.profile = *p;
+    } else {
+      ozone->ErrorMissing("profile", "{table: ...}, {tent: ...} or {exponential: ...}");
+    }
+    o.column_du = ozone->OptionalNumber("column_du", NumberSpec::NonNegative("Dobson units"));
+    if (!o.column_du && !std::holds_alternative<TableProfile>(o.profile)) {
+      ozone->ErrorMissing("column_du", "a non-negative number in Dobson units (needed unless the profile is a table of number densities)");
+    }
+    ozone->Finish();
+    spec.ozone = o;
+  }
+  if (std::optional<std::vector<YamlNode>> layers = root.OptionalSeq("aerosols")) {
+    std::set<std::string> names;
+    for (const YamlNode& layer_node : *layers) {
+      YamlMap layer = layer_node.ToMap("an aerosol layer (a mapping)");
+      if (!layer.valid()) continue;
+      AerosolLayerSpec a;
+      std::optional<YamlNode> name_node = layer.Get("name");
+      if (!name_node) {
+        layer.ErrorMissing("name", "a lowercase identifier");
+      } else if (std::optional<std::string> name = name_node->ToString("a lowercase identifier")) {
+        if (!IsIdentifier(*name)) {
+          name_node->ErrorExpected("a lowercase identifier (a-z, 0-9, _; starting with a letter)");
+        } else if (!names.insert(*name).second) {
+          name_node->Error("aerosol layer name '" + *name + "' is used twice");
+        }
+        a.name = *name;
+      }
+      a.particle = layer.OptionalPath("particle");
+      if (std::optional<YamlNode> prof = layer.Get("profile")) {
+        if (std::optional<ProfileSpec> p = ParseProfile(*prof, {"table", "exponential", "tent"})) a.profile = *p;
+      } else {
+        layer.ErrorMissing("profile", "{table: ...}, {exponential: ...} or {tent: ...}");
+      }
+      if (std::optional<YamlMap> scale = layer.OptionalMap("scale")) {
+        std::string which = scale->ExactlyOneOf({"optical_depth_550nm", "peak_number_density_cm3"});
+        if (which == "optical_depth_550nm") {
+          a.scale = AerosolScale{AerosolScale::Kind::kOpticalDepth550nm,
+                                 scale->Number(which, NumberSpec::NonNegative(""), 0.0)};
+        } else if (which == "peak_number_density_cm3") {
+          a.scale = AerosolScale{AerosolScale::Kind::kPeakNumberDensity,
+                                 scale->Number(which, NumberSpec::NonNegative("cm^-3"), 0.0) * 1e6};
+        }
+        scale->Finish();
+      }
+      layer.Finish();
+      spec.aerosols.push_back(std::move(a));
+    }
+  }
+  root.Finish();
+
+  // Cross-field checks.
+  if (spec.planet && spec.observer_altitude_m >= spec.planet->top_m) {
+    doc.diags().Add(FileLoc{doc.display_name(), 0},
+                    fmt::format("observer.altitude_km ({}) must be below planet.top_km ({})",
+                                FormatExact(spec.observer_altitude_m / 1e3), FormatExact(spec.planet->top_m / 1e3)));
+  }
+  doc.ThrowIfErrors();
+  return spec;
+}
+
+AtmosphereSpec LoadAtmosphere(const std::filesystem::path& path) {
+  YamlDocument doc = YamlDocument::Load(path);
+  return ParseAtmosphere(doc, path.stem().string());
+}
+
+void RequireSections(const AtmosphereSpec& spec, const std::vector<std::string>& sections) {
+  Diagnostics d;
+  for (const std::string& s : sections) {
+    bool present = (s == "planet" && spec.planet) || (s == "grid" && spec.grid) || (s == "air" && spec.air);
+    if (!present) d.Add(FileLoc{spec.file.string(), 0}, "missing section '" + s + "'");
+  }
+  d.ThrowIfAny();
+}
+
+std::string CanonicalProfilesYaml(const AtmosphereSpec& spec, const std::filesystem::path& dir) {
+  YAML::Emitter out;
+  out << YAML::Comment("canonical profile component of " + spec.name + " (written by skybake; do not edit)");
+  out << YAML::BeginMap;
+  out << YAML::Key << "name" << YAML::Value << spec.name;
+  if (spec.planet) {
+    out << YAML::Key << "planet" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "radius_km" << YAML::Value << FormatExact(spec.planet->radius_m / 1e3);
+    out << YAML::Key << "top_km" << YAML::Value << FormatExact(spec.planet->top_m / 1e3);
+    out << YAML::EndMap;
+  }
+  if (spec.grid) {
+    out << YAML::Key << "grid" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "altitude_step_m" << YAML::Value << FormatExact(spec.grid->altitude_step_m);
+    out << YAML::EndMap;
+  }
+  if (spec.air) {
+    out << YAML::Key << "air" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "profile" << YAML::Value;
+    EmitProfile(out, spec.air->profile, dir);
+    if (std::holds_alternative<ExponentialProfile>(spec.air->profile)) {
+      out << YAML::Key << "surface_number_density_m3" << YAML::Value << FormatExact(spec.air->surface_number_density_m3);
+    }
+    out << YAML::EndMap;
+  }
+  if (spec.ozone) {
+    out << YAML::Key << "ozone" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "profile" << YAML::Value;
+    EmitProfile(out, spec.ozone->profile, dir);
+    if (spec.ozone->column_du) out << YAML::Key << "column_du" << YAML::Value << FormatExact(*spec.ozone->column_du);
+    out << YAML::EndMap;
+  }
+  if (!spec.aerosols.empty()) {
+    out << YAML::Key << "aerosols" << YAML::Value << YAML::BeginSeq;
+    for (const AerosolLayerSpec& a : spec.aerosols) {
+      out << YAML::BeginMap;
+      out << YAML::Key << "name" << YAML::Value << a.name;
+      out << YAML::Key << "profile" << YAML::Value;
+      EmitProfile(out, a.profile, dir);
+      out << YAML::EndMap;
+    }
+    out << YAML::EndSeq;
+  }
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+}  // namespace skybake

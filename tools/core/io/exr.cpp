@@ -1,0 +1,277 @@
+#include "io/exr.h"
+
+#include <ImfChannelList.h>
+#include <ImfChromaticitiesAttribute.h>
+#include <ImfDoubleAttribute.h>
+#include <ImfFloatVectorAttribute.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfIO.h>
+#include <ImfInputFile.h>
+#include <ImfIntAttribute.h>
+#include <ImfOutputFile.h>
+#include <ImfStandardAttributes.h>
+#include <ImfStringAttribute.h>
+#include <Iex.h>
+
+#include <cstring>
+
+#include <fmt/format.h>
+
+#include "io/error.h"
+#include "io/fileio.h"
+#include "io/yaml.h"
+#include "skybake/version.h"
+
+namespace skybake {
+
+// ---------------------------------------------------------------------------- in-memory streams
+
+namespace {
+
+class MemOStream : public Imf::OStream {
+ public:
+  MemOStream() : Imf::OStream("<memory>") {}
+  void write(const char c[], int n) override {
+    size_t end = pos_ + static_cast<size_t>(n);
+    if (end > data_.size()) data_.resize(end);
+    std::memcpy(data_.data() + pos_, c, static_cast<size_t>(n));
+    pos_ = end;
+  }
+  uint64_t tellp() override { return pos_; }
+  void seekp(uint64_t pos) override { pos_ = pos; }
+  std::string& data() { return data_; }
+
+ private:
+  std::string data_;
+  size_t pos_ = 0;
+};
+
+class MemIStream : public Imf::IStream {
+ public:
+  MemIStream(const std::string& data, const std::string& name) : Imf::IStream(name.c_str()), data_(data) {}
+  bool read(char c[], int n) override {
+    if (pos_ + static_cast<size_t>(n) > data_.size()) {
+      throw Iex::InputExc("Unexpected end of file.");
+    }
+    std::memcpy(c, data_.data() + pos_, static_cast<size_t>(n));
+    pos_ += static_cast<size_t>(n);
+    return pos_ < data_.size();
+  }
+  uint64_t tellg() override { return pos_; }
+  void seekg(uint64_t pos) override { pos_ = pos; }
+  void clear() override {}
+
+ private:
+  const std::string& data_;
+  size_t pos_ = 0;
+};
+
+}  // namespace
+
+// ---------------------------------------------------------------------------- image helpers
+
+void ExrImage::Resize(int w, int h, std::vector<std::string> channel_names) {
+  width = w;
+  height = h;
+  channels = std::move(channel_names);
+  pixels.assign(static_cast<size_t>(w) * h * channels.size(), 0.0f);
+}
+
+int ExrImage::ChannelIndex(const std::string& name) const {
+  for (size_t i = 0; i < channels.size(); ++i) {
+    if (channels[i] == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+size_t ExrTable::Count() const {
+  size_t n = 1;
+  for (const ExrAxis& a : axes) n *= a.values.size();
+  return n;
+}
+
+int ExrTable::ChannelIndex(const std::string& name) const {
+  for (size_t i = 0; i < channels.size(); ++i) {
+    if (channels[i] == name) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+void Provenance::AddInput(const std::filesystem::path& path) {
+  inputs.emplace_back(path.lexically_normal().string(), HashFile(path));
+}
+
+void SetProvenance(ExrImage& image, const Provenance& p) {
+  image.strings["skybake.tool"] = p.tool;
+  image.strings["skybake.version"] = kVersion;
+  image.strings["skybake.parameters"] = p.parameters;
+  std::string inputs;
+  for (const auto& [path, hash] : p.inputs) inputs += path + " xxh3:" + hash + "\n";
+  image.strings["skybake.inputs"] = inputs;
+}
+
+Imf::Chromaticities XyzChromaticities() {
+  return Imf::Chromaticities(Imath::V2f(1.0f, 0.0f), Imath::V2f(0.0f, 1.0f), Imath::V2f(0.0f, 0.0f),
+                             Imath::V2f(1.0f / 3.0f, 1.0f / 3.0f));
+}
+
+// ---------------------------------------------------------------------------- tables
+
+ExrImage TableToImage(const ExrTable& t) {
+  SKYBAKE_CHECK(!t.axes.empty() && t.axes.size() <= 3);
+  SKYBAKE_CHECK_EQ(t.channels.size(), t.channel_units.size());
+  SKYBAKE_CHECK_EQ(t.values.size(), t.Count() * t.channels.size());
+  ExrImage img;
+  int n0 = static_cast<int>(t.axes[0].values.size());
+  int rest = static_cast<int>(t.Count() / t.axes[0].values.size());
+  img.width = n0;
+  img.height = rest;
+  img.channels = t.channels;
+  img.pixels = t.values;
+  img.strings["skybake.layout"] = "table";
+  img.ints["skybake.axes"] = static_cast<int>(t.axes.size());
+  for (size_t k = 0; k < t.axes.size(); ++k) {
+    const ExrAxis& a = t.axes[k];
+    const std::string pre = fmt::format("skybake.axis{}.", k);
+    img.strings[pre + "name"] = a.name;
+    img.strings[pre + "unit"] = a.unit;
+    img.strings[pre + "description"] = a.description;
+    img.ints[pre + "size"] = static_cast<int>(a.values.size());
+    // Exact coordinates as text (doubles, round-trip exact) and as floats for viewers.
+    std::string exact;
+    std::vector<float> f;
+    for (double v : a.values) {
+      if (!exact.empty()) exact += " ";
+      exact += FormatExact(v);
+      f.push_back(static_cast<float>(v));
+    }
+    img.strings[pre + "values"] = exact;
+    img.float_vectors[pre + "coordinates"] = f;
+  }
+  for (size_t c = 0; c < t.channels.size(); ++c) {
+    img.strings["skybake.unit." + t.channels[c]] = t.channel_units[c];
+  }
+  return img;
+}
+
+ExrTable ImageToTable(const ExrImage& img, const std::string& name) {
+  auto fail = [&](const std::string& what) { throw InputError(FileLoc{name, 0}, what); };
+  auto layout = img.strings.find("skybake.layout");
+  if (layout == img.strings.end() || layout->second != "table") fail("not a skybake table (no skybake.layout = table)");
+  auto axes = img.ints.find("skybake.axes");
+  if (axes == img.ints.end() || axes->second < 1 || axes->second > 3) fail("bad skybake.axes attribute");
+  ExrTable t;
+  size_t count = 1;
+  for (int k = 0; k < axes->second; ++k) {
+    const std::string pre = fmt::format("skybake.axis{}.", k);
+    ExrAxis a;
+    auto get = [&](const std::string& key) -> std::string {
+      auto it = img.strings.find(pre + key);
+      if (it == img.strings.end()) fail("missing attribute " + pre + key);
+      return it->second;
+    };
+    a.name = get("name");
+    a.unit = get("unit");
+    a.description = get("description");
+    std::string vals = get("values");
+    size_t pos = 0;
+    while (pos < vals.size()) {
+      size_t end = vals.find(' ', pos);
+      if (end == std::string::npos) end = vals.size();
+      a.values.push_back(std::stod(vals.substr(pos, end - pos)));
+      pos = end + 1;
+    }
+    count *= a.values.size();
+    t.axes.push_back(std::move(a));
+  }
+  if (static_cast<size_t>(img.width) != t.axes[0].values.size() ||
+      static_cast<size_t>(img.width) * img.height != count) {
+    fail("table axes do not match the image size");
+  }
+  t.channels = img.channels;
+  for (const std::string& c : t.channels) {
+    auto it = img.strings.find("skybake.unit." + c);
+    t.channel_units.push_back(it == img.strings.end() ? std::string() : it->second);
+  }
+  t.values = img.pixels;
+  return t;
+}
+
+// ---------------------------------------------------------------------------- encode / decode
+
+std::string EncodeExr(const ExrImage& img) {
+  SKYBAKE_CHECK(img.width > 0 && img.height > 0);
+  SKYBAKE_CHECK_EQ(img.pixels.size(), static_cast<size_t>(img.width) * img.height * img.channels.size());
+  Imf::Header header(img.width, img.height);
+  header.compression() = Imf::ZIP_COMPRESSION;
+  for (const std::string& c : img.channels) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
+  for (const auto& [k, v] : img.strings) header.insert(k, Imf::StringAttribute(v));
+  for (const auto& [k, v] : img.doubles) header.insert(k, Imf::DoubleAttribute(v));
+  for (const auto& [k, v] : img.ints) header.insert(k, Imf::IntAttribute(v));
+  for (const auto& [k, v] : img.float_vectors) header.insert(k, Imf::FloatVectorAttribute(v));
+  if (img.chromaticities) Imf::addChromaticities(header, *img.chromaticities);
+
+  Imf::FrameBuffer fb;
+  const size_t nch = img.channels.size();
+  const size_t xstride = sizeof(float) * nch;
+  const size_t ystride = xstride * static_cast<size_t>(img.width);
+  for (size_t c = 0; c < nch; ++c) {
+    fb.insert(img.channels[c], Imf::Slice(Imf::FLOAT, (char*)(img.pixels.data() + c), xstride, ystride));
+  }
+  MemOStream os;
+  {
+    Imf::OutputFile out(os, header, 1);
+    out.setFrameBuffer(fb);
+    out.writePixels(img.height);
+  }
+  return std::move(os.data());
+}
+
+bool WriteExr(const std::filesystem::path& path, const ExrImage& image) {
+  return WriteFileIfChanged(path, EncodeExr(image));
+}
+
+ExrImage DecodeExr(const std::string& bytes, const std::string& name) {
+  ExrImage img;
+  try {
+    MemIStream is(bytes, name);
+    Imf::InputFile in(is, 1);
+    const Imf::Header& h = in.header();
+    Imath::Box2i dw = h.dataWindow();
+    img.width = dw.max.x - dw.min.x + 1;
+    img.height = dw.max.y - dw.min.y + 1;
+    for (auto it = h.channels().begin(); it != h.channels().end(); ++it) img.channels.push_back(it.name());
+    for (auto it = h.begin(); it != h.end(); ++it) {
+      const std::string key = it.name();
+      if (auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) img.strings[key] = s->value();
+      else if (auto* d = dynamic_cast<const Imf::DoubleAttribute*>(&it.attribute())) img.doubles[key] = d->value();
+      else if (auto* i = dynamic_cast<const Imf::IntAttribute*>(&it.attribute())) img.ints[key] = i->value();
+      else if (auto* f = dynamic_cast<const Imf::FloatVectorAttribute*>(&it.attribute())) img.float_vectors[key] = f->value();
+    }
+    if (Imf::hasChromaticities(h)) img.chromaticities = Imf::chromaticities(h);
+    img.pixels.assign(static_cast<size_t>(img.width) * img.height * img.channels.size(), 0.0f);
+    Imf::FrameBuffer fb;
+    const size_t nch = img.channels.size();
+    const size_t xstride = sizeof(float) * nch;
+    const size_t ystride = xstride * static_cast<size_t>(img.width);
+    char* base = reinterpret_cast<char*>(img.pixels.data()) -
+                 (static_cast<ptrdiff_t>(dw.min.x) * xstride + static_cast<ptrdiff_t>(dw.min.y) * ystride);
+    for (size_t c = 0; c < nch; ++c) {
+      fb.insert(img.channels[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xstride, ystride));
+    }
+    in.setFrameBuffer(fb);
+    in.readPixels(dw.min.y, dw.max.y);
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError(FileLoc{name, 0}, std::string("not a readable OpenEXR file: ") + e.what());
+  }
+  return img;
+}
+
+ExrImage ReadExr(const std::filesystem::path& path) {
+  return DecodeExr(ReadFileBytes(path), path.string());
+}
+
+}  // namespace skybake

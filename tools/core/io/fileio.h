@@ -1,0 +1,39 @@
+// Files the way Ninja needs them (style.md §8, notes/ninja-ocio-exr-ktx.md §1):
+//  - WriteFileIfChanged: the whole content is prepared in memory first, compared with what is
+//    on disk, and only when it differs written to a temporary file in the same folder, flushed
+//    (fsync) and renamed over the target. A crash or SIGKILL at any moment leaves either the old
+//    file or the new one, never a partial file; an unchanged file keeps its mtime, so Ninja's
+//    `restat = 1` prunes everything downstream.
+//  - Depfiles in Make syntax listing the inputs a tool read (`deps = gcc`).
+//  - Content hashes for provenance (xxHash XXH3-64, hex).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace skybake {
+
+// Reads a whole file; throws InputError(path) if it cannot be read.
+std::string ReadFileBytes(const std::filesystem::path& path);
+
+// Writes `bytes` to `path` atomically unless the file already holds exactly these bytes.
+// Creates missing parent folders. Returns true when the file was (re)written.
+// Throws InputError for I/O failures (e.g. an unwritable folder).
+bool WriteFileIfChanged(const std::filesystem::path& path, std::string_view bytes);
+
+// Make-syntax depfile "target: in1 in2 ...", written with WriteFileIfChanged.
+void WriteDepfile(const std::filesystem::path& depfile, const std::filesystem::path& target,
+                  const std::vector<std::filesystem::path>& inputs);
+
+// XXH3-64 of bytes / of a file's content, as 16 lowercase hex digits.
+std::string HashBytes(std::string_view bytes);
+std::string HashFile(const std::filesystem::path& path);
+
+// Test hook, documented in docs/testing.md: when the environment variable
+// SKYBAKE_TEST_SLOW_WRITE_MS is set, WriteFileIfChanged writes its temporary file in small
+// chunks with that many milliseconds between them, so a test can kill a tool mid-write.
+
+}  // namespace skybake
