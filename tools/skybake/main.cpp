@@ -1,0 +1,78 @@
+// skybake: turns pipeline.yaml into a Ninja graph and bakes it.
+//
+//   skybake generate [pipeline.yaml]        write outputs/build.ninja (+ canonical components)
+//   skybake bake [pipeline.yaml] [-j N] [-- NINJA_ARGS...]   generate, then run ninja
+//   skybake graph [pipeline.yaml]           print the plan (tools, inputs, outputs); writes nothing
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <iostream>
+
+#include "generator.h"
+#include "io/cli.h"
+#include "io/error.h"
+
+namespace fs = std::filesystem;
+using namespace skybake;
+
+namespace {
+fs::path ToolsDir() {
+  std::error_code ec;
+  fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) throw InternalError("cannot locate the skybake binary: " + ec.message());
+  return exe.parent_path();
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  ToolCli cli("skybake",
+              "Generates the Ninja graph of a skybake pipeline (pipeline.yaml) and bakes it.\n"
+              "Only what an edit touches is rebuilt. See docs/pipeline.md.");
+  cli.app().require_subcommand(1);
+  std::string pipeline = "pipeline.yaml";
+  CLI::App* gen = cli.app().add_subcommand("generate", "Write <outputs>/build.ninja and the canonical components");
+  gen->add_option("pipeline", pipeline, "Pipeline file")->capture_default_str();
+  CLI::App* bake = cli.app().add_subcommand("bake", "Generate, then run ninja in the outputs folder");
+  bake->add_option("pipeline", pipeline, "Pipeline file")->capture_default_str();
+  int jobs = 0;
+  bake->add_option("-j,--jobs", jobs, "Parallel ninja jobs (default: ninja's choice)")->check(CLI::NonNegativeNumber);
+  std::vector<std::string> ninja_args;
+  bake->add_option("ninja_args", ninja_args, "Extra arguments for ninja (after --)");
+  CLI::App* graph = cli.app().add_subcommand("graph", "Print the plan (tools, inputs, outputs) without writing anything");
+  graph->add_option("pipeline", pipeline, "Pipeline file")->capture_default_str();
+
+  int exit_code = 0;
+  int rc = cli.Run(argc, argv, [&] {
+    const bool dry = graph->parsed();
+    GenerateResult r = Generate(pipeline, ToolsDir(), dry);
+    if (graph->parsed()) {
+      for (const PlannedEdge& e : r.plan) {
+        std::cout << e.tool << ":";
+        for (const auto& o : e.outputs) std::cout << " " << o;
+        std::cout << "\n";
+        for (const auto& i : e.inputs) std::cout << "    <- " << i << "\n";
+      }
+      return;
+    }
+    cli.Info(std::string(r.changed ? "wrote " : "unchanged ") + r.build_ninja.string());
+    if (!bake->parsed()) return;
+    std::vector<std::string> args = {"ninja", "-C", r.build_ninja.parent_path().string()};
+    if (jobs > 0) args.push_back("-j" + std::to_string(jobs));
+    args.insert(args.end(), ninja_args.begin(), ninja_args.end());
+    std::vector<char*> cargs;
+    for (auto& a : args) cargs.push_back(a.data());
+    cargs.push_back(nullptr);
+    std::cout.flush();
+    pid_t pid = fork();
+    if (pid == 0) {
+      execvp("ninja", cargs.data());
+      std::cerr << "skybake: cannot run ninja (is ninja-build installed?)\n";
+      _exit(127);
+    }
+    int status = 0;
+    waitpid(pid, &status, 0);
+    exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 1;
+  });
+  return rc != 0 ? rc : exit_code;
+}

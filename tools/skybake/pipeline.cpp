@@ -1,0 +1,95 @@
+#include "pipeline.h"
+
+#include <cmath>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "io/yaml.h"
+#include "stage.h"
+
+namespace fs = std::filesystem;
+
+namespace skybake {
+
+std::vector<double> WavelengthGrid::Values() const {
+  std::vector<double> v;
+  const size_t n = static_cast<size_t>(std::llround((max_nm - min_nm) / step_nm));
+  for (size_t i = 0; i <= n; ++i) v.push_back(min_nm + static_cast<double>(i) * step_nm);
+  return v;
+}
+
+Pipeline LoadPipeline(const fs::path& path, const std::vector<Stage*>& stages) {
+  Pipeline p;
+  p.file = fs::absolute(path).lexically_normal();
+  p.root_dir = p.file.parent_path();
+  YamlDocument doc = YamlDocument::Load(p.file);
+  p.files_read.push_back(p.file);
+  YamlMap root = doc.RootMap();
+
+  p.out_dir = (p.root_dir / root.OptionalString("outputs", "a folder path").value_or("outputs")).lexically_normal();
+  p.altitude_step_m = root.NumberOr("altitude_step_m", NumberSpec::Range(1.0, 10000.0, "m"), 100.0);
+  if (std::optional<YamlMap> wl = root.OptionalMap("wavelengths")) {
+    p.wavelengths.min_nm = wl->NumberOr("min_nm", NumberSpec::Range(200.0, 3000.0, "nm"), 360.0);
+    p.wavelengths.max_nm = wl->NumberOr("max_nm", NumberSpec::Range(200.0, 3000.0, "nm"), 830.0);
+    p.wavelengths.step_nm = wl->NumberOr("step_nm", NumberSpec::Positive("nm"), 5.0);
+    if (p.wavelengths.max_nm < p.wavelengths.min_nm) {
+      wl->node().Error("max_nm must not be below min_nm");
+    } else {
+      double n = (p.wavelengths.max_nm - p.wavelengths.min_nm) / p.wavelengths.step_nm;
+      if (std::abs(n - std::round(n)) > 1e-9) wl->node().Error("(max_nm - min_nm) must be a whole number of step_nm");
+    }
+    wl->Finish();
+  }
+  if (std::optional<YamlMap> pools = root.OptionalMap("pools")) {
+    for (auto it = pools->node().raw().begin(); it != pools->node().raw().end(); ++it) {
+      std::string name = it->first.Scalar();
+      if (name == "console") {
+        pools->node().Error("'console' is Ninja's built-in pool and cannot be redefined");
+      }
+      p.pools[name] = static_cast<int>(pools->Integer(name, 1, 1024, "a pool depth from 1 to 1024", 1));
+    }
+    pools->Finish();
+  }
+  std::vector<std::string> tool_names;
+  for (Stage* s : stages) tool_names.push_back(s->tool());
+  if (std::optional<YamlMap> launchers = root.OptionalMap("launchers")) {
+    for (auto it = launchers->node().raw().begin(); it != launchers->node().raw().end(); ++it) {
+      std::string tool = it->first.Scalar();
+      if (std::find(tool_names.begin(), tool_names.end(), tool) == tool_names.end()) continue;  // reported by Finish
+      p.launchers[tool] = launchers->String(tool, "a command prefix");
+    }
+    for (const auto& t : tool_names) launchers->Known({t});
+    launchers->Finish();
+  }
+
+  std::vector<YamlNode> atmospheres = root.Seq("atmospheres");
+  std::set<std::string> names;
+  std::vector<Diagnostic> atmosphere_errors;
+  for (const YamlNode& a : atmospheres) {
+    std::optional<fs::path> file = a.ToPath();
+    if (!file) continue;
+    fs::path abs = fs::absolute(*file).lexically_normal();
+    p.files_read.push_back(abs);
+    try {
+      PipelineAtmosphere pa;
+      pa.file = abs;
+      pa.spec = LoadAtmosphere(abs);
+      pa.name = pa.spec.name;
+      if (!pa.spec.grid) pa.spec.grid = GridSpec{p.altitude_step_m};
+      if (!names.insert(pa.name).second) {
+        a.Error("two atmospheres are named '" + pa.name + "'");
+      }
+      p.atmospheres.push_back(std::move(pa));
+    } catch (const InputError& e) {
+      atmosphere_errors.insert(atmosphere_errors.end(), e.diagnostics().begin(), e.diagnostics().end());
+    }
+  }
+  for (Stage* s : stages) s->ParseConfig(root);
+  root.Finish();
+  for (const Diagnostic& d : atmosphere_errors) doc.diags().Add(d.loc, d.message);
+  doc.ThrowIfErrors();
+  return p;
+}
+
+}  // namespace skybake
