@@ -11,6 +11,7 @@
 #include "io/error.h"
 #include "io/exr.h"
 #include "io/fileio.h"
+#include "io/png.h"
 
 namespace fs = std::filesystem;
 using namespace skybake;
@@ -94,4 +95,34 @@ TEST(Exr, TruncatedAndGarbageFilesAreInputErrors) {
   } catch (const InputError& e) {
     EXPECT_STREQ(e.what(), "/nonexistent.exr: cannot open file");
   }
+}
+
+TEST(Exr, MultiPartRoundTrip) {
+  ExrImage a, b;
+  a.Resize(3, 2, {"x"});
+  b.Resize(5, 1, {"u", "v"});
+  for (size_t i = 0; i < a.pixels.size(); ++i) a.pixels[i] = static_cast<float>(i);
+  for (size_t i = 0; i < b.pixels.size(); ++i) b.pixels[i] = -static_cast<float>(i);
+  b.strings["skybake.note"] = "second";
+  std::string bytes = EncodeExrParts({{"first", a}, {"second", b}});
+  EXPECT_EQ(bytes, EncodeExrParts({{"first", a}, {"second", b}}));
+  std::vector<ExrPart> back = DecodeExrParts(bytes, "mem.exr");
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(FindPart(back, "first", "mem.exr").pixels, a.pixels);
+  EXPECT_EQ(FindPart(back, "second", "mem.exr").pixels, b.pixels);
+  EXPECT_EQ(FindPart(back, "second", "mem.exr").strings.at("skybake.note"), "second");
+  EXPECT_THROW(FindPart(back, "third", "mem.exr"), InputError);
+}
+
+TEST(Png, RoundTripAndDeterminism) {
+  std::vector<uint8_t> px(4 * 3 * 3);
+  for (size_t i = 0; i < px.size(); ++i) px[i] = static_cast<uint8_t>(i * 7);
+  std::string bytes = EncodePng8(4, 3, 3, px);
+  EXPECT_EQ(bytes, EncodePng8(4, 3, 3, px));
+  int w = 0, h = 0, c = 0;
+  EXPECT_EQ(DecodePng8(bytes, "mem.png", &w, &h, &c), px);
+  EXPECT_EQ(w, 4);
+  EXPECT_EQ(h, 3);
+  EXPECT_EQ(c, 3);
+  EXPECT_THROW(DecodePng8("garbage!", "g.png", &w, &h, &c), InputError);
 }

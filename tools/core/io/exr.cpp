@@ -8,6 +8,11 @@
 #include <ImfHeader.h>
 #include <ImfIO.h>
 #include <ImfInputFile.h>
+#include <ImfInputPart.h>
+#include <ImfMultiPartInputFile.h>
+#include <ImfMultiPartOutputFile.h>
+#include <ImfOutputPart.h>
+#include <ImfPartType.h>
 #include <ImfIntAttribute.h>
 #include <ImfOutputFile.h>
 #include <ImfStandardAttributes.h>
@@ -200,7 +205,9 @@ ExrTable ImageToTable(const ExrImage& img, const std::string& name) {
 
 // ---------------------------------------------------------------------------- encode / decode
 
-std::string EncodeExr(const ExrImage& img) {
+namespace {
+
+Imf::Header MakeHeader(const ExrImage& img) {
   SKYBAKE_CHECK(img.width > 0 && img.height > 0);
   SKYBAKE_CHECK_EQ(img.pixels.size(), static_cast<size_t>(img.width) * img.height * img.channels.size());
   Imf::Header header(img.width, img.height);
@@ -211,7 +218,10 @@ std::string EncodeExr(const ExrImage& img) {
   for (const auto& [k, v] : img.ints) header.insert(k, Imf::IntAttribute(v));
   for (const auto& [k, v] : img.float_vectors) header.insert(k, Imf::FloatVectorAttribute(v));
   if (img.chromaticities) Imf::addChromaticities(header, *img.chromaticities);
+  return header;
+}
 
+Imf::FrameBuffer MakeFrameBuffer(const ExrImage& img) {
   Imf::FrameBuffer fb;
   const size_t nch = img.channels.size();
   const size_t xstride = sizeof(float) * nch;
@@ -219,6 +229,42 @@ std::string EncodeExr(const ExrImage& img) {
   for (size_t c = 0; c < nch; ++c) {
     fb.insert(img.channels[c], Imf::Slice(Imf::FLOAT, (char*)(img.pixels.data() + c), xstride, ystride));
   }
+  return fb;
+}
+
+// Fills `img` (header attributes, channels, pixels) from a part's header; returns the frame
+// buffer to read into.
+Imf::FrameBuffer PrepareRead(const Imf::Header& h, ExrImage& img) {
+  Imath::Box2i dw = h.dataWindow();
+  img.width = dw.max.x - dw.min.x + 1;
+  img.height = dw.max.y - dw.min.y + 1;
+  for (auto it = h.channels().begin(); it != h.channels().end(); ++it) img.channels.push_back(it.name());
+  for (auto it = h.begin(); it != h.end(); ++it) {
+    const std::string key = it.name();
+    if (auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) img.strings[key] = s->value();
+    else if (auto* d = dynamic_cast<const Imf::DoubleAttribute*>(&it.attribute())) img.doubles[key] = d->value();
+    else if (auto* i = dynamic_cast<const Imf::IntAttribute*>(&it.attribute())) img.ints[key] = i->value();
+    else if (auto* f = dynamic_cast<const Imf::FloatVectorAttribute*>(&it.attribute())) img.float_vectors[key] = f->value();
+  }
+  if (Imf::hasChromaticities(h)) img.chromaticities = Imf::chromaticities(h);
+  img.pixels.assign(static_cast<size_t>(img.width) * img.height * img.channels.size(), 0.0f);
+  Imf::FrameBuffer fb;
+  const size_t nch = img.channels.size();
+  const size_t xstride = sizeof(float) * nch;
+  const size_t ystride = xstride * static_cast<size_t>(img.width);
+  char* base = reinterpret_cast<char*>(img.pixels.data()) -
+               (static_cast<ptrdiff_t>(dw.min.x) * xstride + static_cast<ptrdiff_t>(dw.min.y) * ystride);
+  for (size_t c = 0; c < nch; ++c) {
+    fb.insert(img.channels[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xstride, ystride));
+  }
+  return fb;
+}
+
+}  // namespace
+
+std::string EncodeExr(const ExrImage& img) {
+  Imf::Header header = MakeHeader(img);
+  Imf::FrameBuffer fb = MakeFrameBuffer(img);
   MemOStream os;
   {
     Imf::OutputFile out(os, header, 1);
@@ -237,30 +283,9 @@ ExrImage DecodeExr(const std::string& bytes, const std::string& name) {
   try {
     MemIStream is(bytes, name);
     Imf::InputFile in(is, 1);
-    const Imf::Header& h = in.header();
-    Imath::Box2i dw = h.dataWindow();
-    img.width = dw.max.x - dw.min.x + 1;
-    img.height = dw.max.y - dw.min.y + 1;
-    for (auto it = h.channels().begin(); it != h.channels().end(); ++it) img.channels.push_back(it.name());
-    for (auto it = h.begin(); it != h.end(); ++it) {
-      const std::string key = it.name();
-      if (auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) img.strings[key] = s->value();
-      else if (auto* d = dynamic_cast<const Imf::DoubleAttribute*>(&it.attribute())) img.doubles[key] = d->value();
-      else if (auto* i = dynamic_cast<const Imf::IntAttribute*>(&it.attribute())) img.ints[key] = i->value();
-      else if (auto* f = dynamic_cast<const Imf::FloatVectorAttribute*>(&it.attribute())) img.float_vectors[key] = f->value();
-    }
-    if (Imf::hasChromaticities(h)) img.chromaticities = Imf::chromaticities(h);
-    img.pixels.assign(static_cast<size_t>(img.width) * img.height * img.channels.size(), 0.0f);
-    Imf::FrameBuffer fb;
-    const size_t nch = img.channels.size();
-    const size_t xstride = sizeof(float) * nch;
-    const size_t ystride = xstride * static_cast<size_t>(img.width);
-    char* base = reinterpret_cast<char*>(img.pixels.data()) -
-                 (static_cast<ptrdiff_t>(dw.min.x) * xstride + static_cast<ptrdiff_t>(dw.min.y) * ystride);
-    for (size_t c = 0; c < nch; ++c) {
-      fb.insert(img.channels[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xstride, ystride));
-    }
+    Imf::FrameBuffer fb = PrepareRead(in.header(), img);
     in.setFrameBuffer(fb);
+    Imath::Box2i dw = in.header().dataWindow();
     in.readPixels(dw.min.y, dw.max.y);
   } catch (const InputError&) {
     throw;
@@ -268,6 +293,71 @@ ExrImage DecodeExr(const std::string& bytes, const std::string& name) {
     throw InputError(FileLoc{name, 0}, std::string("not a readable OpenEXR file: ") + e.what());
   }
   return img;
+}
+
+std::string EncodeExrParts(const std::vector<ExrPart>& parts) {
+  SKYBAKE_CHECK(!parts.empty());
+  std::vector<Imf::Header> headers;
+  for (const ExrPart& p : parts) {
+    Imf::Header h = MakeHeader(p.image);
+    h.setName(p.name);
+    h.setType(Imf::SCANLINEIMAGE);
+    // Multi-part files require identical shared attributes: every part takes the first part's
+    // display window (each keeps its own data window, which is what holds the pixels).
+    if (!headers.empty()) h.displayWindow() = headers.front().displayWindow();
+    headers.push_back(h);
+  }
+  MemOStream os;
+  {
+    Imf::MultiPartOutputFile out(os, headers.data(), static_cast<int>(headers.size()), false, 1);
+    for (size_t i = 0; i < parts.size(); ++i) {
+      Imf::OutputPart part(out, static_cast<int>(i));
+      Imf::FrameBuffer fb = MakeFrameBuffer(parts[i].image);
+      part.setFrameBuffer(fb);
+      part.writePixels(parts[i].image.height);
+    }
+  }
+  return std::move(os.data());
+}
+
+bool WriteExrParts(const std::filesystem::path& path, const std::vector<ExrPart>& parts) {
+  return WriteFileIfChanged(path, EncodeExrParts(parts));
+}
+
+std::vector<ExrPart> DecodeExrParts(const std::string& bytes, const std::string& name) {
+  std::vector<ExrPart> parts;
+  try {
+    MemIStream is(bytes, name);
+    Imf::MultiPartInputFile in(is, 1);
+    for (int i = 0; i < in.parts(); ++i) {
+      ExrPart p;
+      const Imf::Header& h = in.header(i);
+      p.name = h.hasName() ? h.name() : std::string();
+      Imf::InputPart part(in, i);
+      Imf::FrameBuffer fb = PrepareRead(h, p.image);
+      part.setFrameBuffer(fb);
+      Imath::Box2i dw = h.dataWindow();
+      part.readPixels(dw.min.y, dw.max.y);
+      parts.push_back(std::move(p));
+    }
+  } catch (const InputError&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InputError(FileLoc{name, 0}, std::string("not a readable OpenEXR file: ") + e.what());
+  }
+  return parts;
+}
+
+std::vector<ExrPart> ReadExrParts(const std::filesystem::path& path) {
+  return DecodeExrParts(ReadFileBytes(path), path.string());
+}
+
+const ExrImage& FindPart(const std::vector<ExrPart>& parts, const std::string& part_name,
+                         const std::string& display_name) {
+  for (const ExrPart& p : parts) {
+    if (p.name == part_name) return p.image;
+  }
+  throw InputError(FileLoc{display_name, 0}, "no part named '" + part_name + "'");
 }
 
 ExrImage ReadExr(const std::filesystem::path& path) {

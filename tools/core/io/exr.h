@@ -94,4 +94,20 @@ bool WriteExr(const std::filesystem::path& path, const ExrImage& image);
 ExrImage ReadExr(const std::filesystem::path& path);
 ExrImage DecodeExr(const std::string& bytes, const std::string& display_name);
 
+// Multi-part files: one ExrImage per part, each with a unique part name (stored as the part's
+// `name`). Used where one product holds several tables of different shapes (e.g. per-wavelength
+// scalars beside a phase-function table). Same determinism and atomicity as single-part files.
+struct ExrPart {
+  std::string name;
+  ExrImage image;
+};
+std::string EncodeExrParts(const std::vector<ExrPart>& parts);
+bool WriteExrParts(const std::filesystem::path& path, const std::vector<ExrPart>& parts);
+// Reads every part (a single-part file gives one part named after its `name` attribute or "").
+std::vector<ExrPart> ReadExrParts(const std::filesystem::path& path);
+std::vector<ExrPart> DecodeExrParts(const std::string& bytes, const std::string& display_name);
+// The part called `name`; throws InputError(display_name) if absent.
+const ExrImage& FindPart(const std::vector<ExrPart>& parts, const std::string& name,
+                         const std::string& display_name);
+
 }  // namespace skybake
