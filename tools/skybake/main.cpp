@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
               "Generates the Ninja graph of a skybake pipeline (pipeline.yaml) and bakes it.\n"
               "Only what an edit touches is rebuilt. See docs/pipeline.md.");
   cli.app().require_subcommand(1);
+  cli.app().fallthrough();  // --threads/--quiet may follow the subcommand name
   std::string pipeline = "pipeline.yaml";
   CLI::App* gen = cli.app().add_subcommand("generate", "Write <outputs>/build.ninja and the canonical components");
   gen->add_option("pipeline", pipeline, "Pipeline file")->capture_default_str();

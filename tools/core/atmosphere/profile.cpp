@@ -146,10 +146,9 @@ std::vector<double> SampleShape(const ProfileSpec& spec, const std::vector<doubl
     const Interpolant1D& f = table->values;
     if (!tb->zero_outside && !f.Covers(z.front(), z.back())) {
       throw InputError(FileLoc{tb->file.string(), 0},
-                       fmt::format("the table covers altitudes {} to {} m but the atmosphere needs {} to {} m "
+                       fmt::format("the table covers altitudes {:g} to {:g} km but the atmosphere needs {:g} to {:g} km "
                                    "(extend the table or set 'outside: zero')",
-                                   FormatExact(f.x_min()), FormatExact(f.x_max()), FormatExact(z.front()),
-                                   FormatExact(z.back())));
+                                   f.x_min() / 1e3, f.x_max() / 1e3, z.front() / 1e3, z.back() / 1e3));
     }
     for (size_t i = 0; i < z.size(); ++i) out[i] = f.Covers(z[i], z[i]) ? f.Eval(z[i]) : 0.0;
   } else {

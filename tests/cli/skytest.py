@@ -1,0 +1,113 @@
+"""Helpers shared by the CLI and pipeline tests (python3 stdlib only).
+
+The tests run the real binaries from SKYBAKE_BIN_DIR (set by CTest) on files under
+SKYBAKE_SOURCE_DIR, as OpenEXR's src/test/bin and ninja's misc/output_test.py do.
+"""
+import os
+import shutil
+import struct
+import subprocess
+import tempfile
+import unittest
+
+BIN = os.environ.get("SKYBAKE_BIN_DIR", os.path.join(os.path.dirname(__file__), "..", "..", "build", "dev", "bin"))
+SRC = os.environ.get("SKYBAKE_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+
+
+def tool(name):
+    return os.path.join(BIN, name)
+
+
+def run(args, cwd=None, env=None, timeout=600):
+    """Runs a command, returns CompletedProcess with text stdout/stderr."""
+    e = dict(os.environ)
+    if env:
+        e.update(env)
+    return subprocess.run(args, cwd=cwd, env=e, capture_output=True, text=True, timeout=timeout)
+
+
+def exr_attributes(path):
+    """Reads the string attributes of an OpenEXR header (enough to check provenance) without
+    any EXR library: magic, version, then (name, type, size, value) triples until a 0 byte."""
+    with open(path, "rb") as f:
+        data = f.read()
+    assert data[:4] == b"\x76\x2f\x31\x01", "not an OpenEXR file"
+    pos = 8
+    attrs = {}
+    while True:
+        end = data.index(b"\0", pos)
+        name = data[pos:end].decode()
+        pos = end + 1
+        if not name:
+            break
+        end = data.index(b"\0", pos)
+        typ = data[pos:end].decode()
+        pos = end + 1
+        (size,) = struct.unpack_from("<i", data, pos)
+        pos += 4
+        value = data[pos:pos + size]
+        pos += size
+        if typ == "string":
+            attrs[name] = value.decode()
+        elif typ == "int":
+            attrs[name] = struct.unpack("<i", value)[0]
+        elif typ == "double":
+            attrs[name] = struct.unpack("<d", value)[0]
+        elif typ == "float":
+            attrs[name] = struct.unpack("<f", value)[0]
+        else:
+            attrs[name] = (typ, value)
+    return attrs
+
+
+class TempDirTestCase(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix="skybake_test_")
+
+    def tearDown(self):
+        shutil.rmtree(self.tmp, ignore_errors=True)
+
+    def path(self, *parts):
+        return os.path.join(self.tmp, *parts)
+
+    def write(self, rel, text):
+        p = self.path(rel)
+        os.makedirs(os.path.dirname(p), exist_ok=True)
+        with open(p, "w") as f:
+            f.write(text)
+        return p
+
+
+class CliContract:
+    """Mixin: the CLI contract every tool must satisfy (docs/developing.md). Subclasses set
+    TOOL and VALID_ARGS (a list, relative to SRC) and may override as needed."""
+    TOOL = None
+
+    def test_help_goes_to_stdout_and_exits_0(self):
+        r = run([tool(self.TOOL), "--help"])
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("Usage", r.stdout)
+        self.assertEqual(r.stderr, "")
+
+    def test_version(self):
+        r = run([tool(self.TOOL), "--version"])
+        self.assertEqual(r.returncode, 0)
+        self.assertRegex(r.stdout.strip(), r"^%s \(skybake\) \d+\.\d+\.\d+$" % self.TOOL)
+
+    def test_no_arguments_is_a_usage_error(self):
+        r = run([tool(self.TOOL)])
+        self.assertEqual(r.returncode, 2, r.stdout + r.stderr)
+        self.assertTrue(r.stderr.startswith(self.TOOL + ": "), r.stderr)
+        self.assertEqual(r.stdout, "")
+
+    def test_unknown_option_is_a_usage_error(self):
+        r = run([tool(self.TOOL), "--no-such-option"])
+        self.assertEqual(r.returncode, 2)
+        self.assertTrue(r.stderr.startswith(self.TOOL + ": "), r.stderr)
+        self.assertIn("--help", r.stderr)
+
+    def test_bad_threads_value_is_a_usage_error(self):
+        r = run([tool(self.TOOL), "--threads", "-3", "--help"])
+        self.assertIn(r.returncode, (0, 2))  # --help wins in CLI11; a lone bad value must be 2
+        r = run([tool(self.TOOL), "--threads", "abc"])
+        self.assertEqual(r.returncode, 2)

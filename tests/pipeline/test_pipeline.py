@@ -1,0 +1,214 @@
+"""The generated Ninja pipeline on a temporary copy of the repo's atmospheres (issue 2).
+
+Checks: a fresh bake builds; a second run has no work; an edit to one atmosphere re-runs only
+that atmosphere's edges; comment/whitespace edits re-run nothing downstream; missingdeps is
+clean; removing an atmosphere + cleandead removes its outputs; a malformed atmosphere fails
+with file:line and leaves every output intact; deleting generator inputs/components regenerates.
+"""
+import os
+import re
+import shutil
+import sys
+import unittest
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "cli"))
+from skytest import SRC, TempDirTestCase, run, tool  # noqa: E402
+
+PIPELINE = """outputs: outputs
+altitude_step_m: 100
+atmospheres:
+  - atmospheres/clear.yaml
+  - atmospheres/hazed.yaml
+pools:
+  render: 1
+"""
+
+
+def edges_run(ninja_stdout):
+    """The descriptions of the edges ninja ran ("[1/2] profile-import x" -> "profile-import x")."""
+    return [m.group(1) for m in re.finditer(r"^\[\d+/\d+\] (.*)$", ninja_stdout, re.M)]
+
+
+class PipelineTest(TempDirTestCase):
+    def setUp(self):
+        super().setUp()
+        shutil.copytree(os.path.join(SRC, "atmospheres"), self.path("atmospheres"))
+        for extra in ("particles", "clouds", "ocio"):
+            if os.path.isdir(os.path.join(SRC, extra)):
+                shutil.copytree(os.path.join(SRC, extra), self.path(extra))
+        self.write("pipeline.yaml", PIPELINE)
+        self.out = self.path("outputs")
+
+    def bake(self):
+        r = run([tool("skybake"), "bake", "pipeline.yaml"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+        return r
+
+    def ninja(self, *args, expect=0):
+        r = run(["ninja", "-C", self.out] + list(args))
+        self.assertEqual(r.returncode, expect, r.stdout + r.stderr)
+        return r
+
+    def edit(self, rel, old, new):
+        p = self.path(rel)
+        with open(p) as f:
+            text = f.read()
+        self.assertIn(old, text)
+        with open(p, "w") as f:
+            f.write(text.replace(old, new, 1))
+
+    def mtimes(self):
+        out = {}
+        for root, _, files in os.walk(self.out):
+            for f in files:
+                p = os.path.join(root, f)
+                out[os.path.relpath(p, self.out)] = os.stat(p).st_mtime_ns
+        return out
+
+    def test_fresh_bake_then_no_work(self):
+        r = self.bake()
+        self.assertEqual(sorted(edges_run(r.stdout)),
+                         ["profile-import clear/profiles.exr", "profile-import hazed/profiles.exr"])
+        for atm in ("clear", "hazed"):
+            self.assertTrue(os.path.isfile(os.path.join(self.out, atm, "profiles.exr")))
+        self.assertIn("no work to do", self.ninja("-n").stdout)
+        self.assertIn("no work to do", self.ninja().stdout)
+
+    def test_missingdeps_is_clean(self):
+        self.bake()
+        r = self.ninja("-t", "missingdeps")
+        self.assertIn("No missing dependencies", r.stdout)
+
+    def test_editing_one_atmosphere_profile_reruns_only_its_edge(self):
+        self.bake()
+        before = self.mtimes()
+        self.edit("atmospheres/hazed.yaml", "extinction_550nm_per_km_vis5", "extinction_550nm_per_km_vis10")
+        r = self.ninja("-d", "explain")
+        self.assertEqual(edges_run(r.stdout), ["Regenerating build.ninja", "profile-import hazed/profiles.exr"])
+        after = self.mtimes()
+        self.assertEqual(before["clear/profiles.exr"], after["clear/profiles.exr"])
+        self.assertEqual(before["clear/components/profiles.yaml"], after["clear/components/profiles.yaml"])
+        self.assertNotEqual(before["hazed/profiles.exr"], after["hazed/profiles.exr"])
+        self.assertIn("no work to do", self.ninja("-n").stdout)
+
+    def test_editing_a_value_in_a_private_profile_table_reruns_only_its_edge(self):
+        shutil.copy(self.path("atmospheres/data/aerosol_extinction_shettle_fenn_550nm.csv"),
+                    self.path("atmospheres/data/hazed_private.csv"))
+        self.edit("atmospheres/hazed.yaml", "aerosol_extinction_shettle_fenn_550nm.csv", "hazed_private.csv")
+        self.bake()
+        self.edit("atmospheres/data/hazed_private.csv", "\n1,4.150e-02,9.910e-02,3.790e-01,7.700e-01\n",
+                  "\n1,4.150e-02,9.910e-02,3.790e-01,6.500e-01\n")
+        r = self.ninja()
+        self.assertEqual(edges_run(r.stdout), ["profile-import hazed/profiles.exr"])
+
+    def test_comment_and_whitespace_edits_rerun_nothing_downstream(self):
+        self.bake()
+        before = self.mtimes()
+        self.edit("atmospheres/clear.yaml", "name: clear\n", "name: clear   # a new comment\n\n")
+        r = self.ninja()
+        self.assertEqual(edges_run(r.stdout), ["Regenerating build.ninja"])
+        self.edit("pipeline.yaml", "pools:", "# comment\npools:")
+        r = self.ninja()
+        self.assertEqual(edges_run(r.stdout), ["Regenerating build.ninja"])
+        after = self.mtimes()
+        for k in before:
+            if not k.startswith(".ninja"):
+                self.assertEqual(before[k], after[k], k)
+
+    def test_removing_an_atmosphere_and_cleandead(self):
+        self.bake()
+        self.edit("pipeline.yaml", "  - atmospheres/hazed.yaml\n", "")
+        os.remove(self.path("atmospheres/hazed.yaml"))  # a deleted generator input regenerates, not fails
+        r = self.ninja()
+        self.assertEqual(edges_run(r.stdout), ["Regenerating build.ninja"])
+        r = self.ninja("-t", "cleandead")
+        self.assertFalse(os.path.exists(os.path.join(self.out, "hazed", "profiles.exr")))
+        self.assertFalse(os.path.exists(os.path.join(self.out, "hazed", "components", "profiles.yaml")))
+        self.assertTrue(os.path.exists(os.path.join(self.out, "clear", "profiles.exr")))
+        self.assertIn("no work to do", self.ninja("-n").stdout)
+
+    def test_deleted_component_is_regenerated(self):
+        self.bake()
+        before = self.mtimes()
+        os.remove(os.path.join(self.out, "clear", "components", "profiles.yaml"))
+        r = self.ninja()
+        # The component comes back (new mtime), its tool re-runs, writes identical bytes and
+        # restat stops there: the product keeps its mtime.
+        self.assertEqual(edges_run(r.stdout), ["Regenerating build.ninja", "profile-import clear/profiles.exr"])
+        self.assertTrue(os.path.exists(os.path.join(self.out, "clear", "components", "profiles.yaml")))
+        self.assertEqual(before["clear/profiles.exr"], self.mtimes()["clear/profiles.exr"])
+        self.assertIn("no work to do", self.ninja("-n").stdout)
+
+    def test_malformed_atmosphere_fails_with_file_line_and_keeps_outputs(self):
+        self.bake()
+        before = self.mtimes()
+        with open(os.path.join(self.out, "build.ninja")) as f:
+            ninja_before = f.read()
+        self.edit("atmospheres/hazed.yaml", "column_du: 300.0", "column_du: lots")
+        r = self.ninja(expect=1)
+        self.assertIn("skybake: %s:18: key 'ozone.column_du': expected a non-negative number in Dobson units, got \"lots\""
+                      % os.path.join(self.tmp, "atmospheres", "hazed.yaml"), r.stdout + r.stderr)
+        after = self.mtimes()
+        for k in before:
+            if not k.startswith(".ninja"):
+                self.assertEqual(before[k], after[k], k)
+        with open(os.path.join(self.out, "build.ninja")) as f:
+            self.assertEqual(f.read(), ninja_before)
+        # Fixing the file recovers; the fix restores the old content so nothing reruns.
+        self.edit("atmospheres/hazed.yaml", "column_du: lots", "column_du: 300.0")
+        r = self.ninja()
+        self.assertEqual(edges_run(r.stdout), ["Regenerating build.ninja"])
+
+    def test_graph_prints_the_plan_without_writing(self):
+        r = run([tool("skybake"), "graph", "pipeline.yaml"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertIn("profile-import: clear/profiles.exr", r.stdout)
+        self.assertIn("<- clear/components/profiles.yaml", r.stdout)
+        self.assertFalse(os.path.exists(self.out))
+
+    def test_launcher_prefix_and_pools_reach_build_ninja(self):
+        self.edit("pipeline.yaml", "pools:", "launchers:\n  profile-import: \"env SKYBAKE_LAUNCHED=1\"\npools:")
+        self.bake()
+        with open(os.path.join(self.out, "build.ninja")) as f:
+            text = f.read()
+        self.assertRegex(text, r"command = env SKYBAKE_LAUNCHED=1 \S*profile-import ")
+        self.assertIn("pool render\n  depth = 1\n", text)
+
+    def test_unknown_launcher_tool_is_an_error(self):
+        self.edit("pipeline.yaml", "pools:", "launchers:\n  profile-imprt: srun\npools:")
+        r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("pipeline.yaml:7: unknown key 'launchers.profile-imprt' (did you mean 'profile-import'?)", r.stderr)
+
+
+class KillMidWriteTest(TempDirTestCase):
+    """A tool killed (SIGKILL) while writing leaves the previous output intact."""
+
+    def test_sigkill_during_a_large_write_keeps_the_old_file(self):
+        import signal
+        import subprocess
+        import time
+        small = self.write("a.yaml", "planet: {radius_km: 6371, top_km: 100}\ngrid: {altitude_step_m: 100}\nair: {profile: ussa1976}\n")
+        big = self.write("b.yaml", "planet: {radius_km: 6371, top_km: 100}\ngrid: {altitude_step_m: 1}\nair: {profile: ussa1976}\n")
+        out = self.path("p.exr")
+        self.assertEqual(run([tool("profile-import"), small, "-o", out]).returncode, 0)
+        with open(out, "rb") as f:
+            old = f.read()
+        env = dict(os.environ, SKYBAKE_TEST_SLOW_WRITE_MS="20")
+        p = subprocess.Popen([tool("profile-import"), big, "-o", out], env=env,
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        tmp = out + ".tmp-%d" % p.pid
+        deadline = time.time() + 60
+        while time.time() < deadline and not (os.path.exists(tmp) and os.path.getsize(tmp) > 16384):
+            time.sleep(0.01)
+        self.assertTrue(os.path.exists(tmp), "the tool never started writing")
+        p.send_signal(signal.SIGKILL)
+        p.wait()
+        with open(out, "rb") as f:
+            self.assertEqual(f.read(), old)
+        # The next successful run replaces it completely.
+        self.assertEqual(run([tool("profile-import"), small, "-o", out]).returncode, 0)
+
+
+if __name__ == "__main__":
+    unittest.main()
