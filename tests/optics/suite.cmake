@@ -1,0 +1,1 @@
+skybake_add_test_suite(NAME optics DEPS skybake_optics skybake_atmosphere skybake_io)

@@ -1,0 +1,1 @@
+skybake_add_core_module(NAME optics DEPS skybake_io)
