@@ -28,6 +28,48 @@ bool IsIdentifier(const std::string& s) {
   return true;
 }
 
+std::optional<SpectralTableRef> ParseSpectralTable(YamlMap m) {
+  SpectralTableRef t;
+  std::optional<std::filesystem::path> file = m.Path("file");
+  t.wavelength_column = m.String("wavelength_column", "a column name such as wavelength_nm");
+  t.value_column = m.String("value_column", "a column name");
+  if (std::optional<YamlMap> where = m.OptionalMap("where")) {
+    YAML::Node raw = where->node().raw();
+    if (raw.size() != 1) {
+      where->node().Error("expected exactly one 'column: value' pair");
+    } else {
+      auto it = raw.begin();
+      std::string col = it->first.Scalar();
+      t.where = std::make_pair(col, where->String(col, "a cell value"));
+    }
+    where->Finish();
+  }
+  m.Finish();
+  if (!file) return std::nullopt;
+  t.file = *file;
+  return t;
+}
+
+void EmitSpectralTable(YAML::Emitter& out, const SpectralTableRef& t, const std::filesystem::path& dir) {
+  out << YAML::BeginMap;
+  out << YAML::Key << "file" << YAML::Value << t.file.lexically_relative(dir).generic_string();
+  out << YAML::Key << "wavelength_column" << YAML::Value << t.wavelength_column;
+  out << YAML::Key << "value_column" << YAML::Value << t.value_column;
+  if (t.where) {
+    out << YAML::Key << "where" << YAML::Value << YAML::BeginMap << YAML::Key << t.where->first << YAML::Value
+        << t.where->second << YAML::EndMap;
+  }
+  out << YAML::EndMap;
+}
+
+void EmitPlanet(YAML::Emitter& out, const AtmosphereSpec& spec) {
+  if (!spec.planet) return;
+  out << YAML::Key << "planet" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "radius_km" << YAML::Value << FormatExact(spec.planet->radius_m / 1e3);
+  out << YAML::Key << "top_km" << YAML::Value << FormatExact(spec.planet->top_m / 1e3);
+  out << YAML::EndMap;
+}
+
 }  // namespace
 
 AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& default_name) {
@@ -62,6 +104,7 @@ AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& defau
     }
     a.surface_number_density_m3 =
         air->NumberOr("surface_number_density_m3", NumberSpec::Positive("m^-3"), a.surface_number_density_m3);
+    a.co2_ppm = air->NumberOr("co2_ppm", NumberSpec::Range(0.0, 10000.0, "ppm"), a.co2_ppm);
     air->Finish();
     spec.air = a;
   }
@@ -73,6 +116,26 @@ AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& defau
       ozone->ErrorMissing("profile", "{table: ...}, {tent: ...} or {exponential: ...}");
     }
     o.column_du = ozone->OptionalNumber("column_du", NumberSpec::NonNegative("Dobson units"));
+    if (std::optional<YamlMap> xs = ozone->OptionalMap("cross_section")) {
+      OzoneCrossSectionSpec c;
+      std::string kind = xs->ExactlyOneOf({"table", "bogumil2003"});
+      if (kind == "table") {
+        c.kind = OzoneCrossSectionSpec::Kind::kTable;
+        if (auto t = ParseSpectralTable(xs->Map("table"))) c.table = *t;
+      } else if (kind == "bogumil2003") {
+        c.kind = OzoneCrossSectionSpec::Kind::kBogumil2003;
+        YamlMap b = xs->Map("bogumil2003");
+        if (auto f = b.Path("file")) c.bogumil_file = *f;
+        if (std::optional<YamlNode> t = b.Get("temperature_K")) {
+          if (!(t->IsScalar() && t->raw().Scalar() == "local")) {
+            c.temperature_k = t->ToNumber(NumberSpec::Range(203.0, 293.0, "K (the fit's range), or 'local'"));
+          }
+        }
+        b.Finish();
+      }
+      xs->Finish();
+      o.cross_section = c;
+    }
     if (!o.column_du && !std::holds_alternative<TableProfile>(o.profile)) {
       ozone->ErrorMissing("column_du", "a non-negative number in Dobson units (needed unless the profile is a table of number densities)");
     }
@@ -117,6 +180,36 @@ AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& defau
       spec.aerosols.push_back(std::move(a));
     }
   }
+  if (std::optional<YamlMap> ground = root.OptionalMap("ground")) {
+    GroundSpec g;
+    if (std::optional<YamlNode> albedo = ground->Get("albedo")) {
+      if (albedo->IsMap()) {
+        g.albedo_table = ParseSpectralTable(albedo->ToMap());
+      } else {
+        g.albedo = albedo->ToNumber(NumberSpec::Range(0.0, 1.0, "(a constant albedo) or a table mapping"));
+      }
+    } else {
+      ground->ErrorMissing("albedo", "a number from 0 to 1 or {file, wavelength_column, value_column}");
+    }
+    ground->Finish();
+    spec.ground = g;
+  }
+  if (std::optional<YamlMap> sun = root.OptionalMap("sun")) {
+    SunSpec s;
+    if (auto t = ParseSpectralTable(sun->Map("spectrum"))) s.spectrum = *t;
+    s.angular_diameter_deg = sun->NumberOr("angular_diameter_deg", NumberSpec::Range(0.01, 20.0, "degrees"), s.angular_diameter_deg);
+    if (std::optional<YamlNode> ld = sun->Get("limb_darkening")) {
+      if (ld->IsScalar() && ld->raw().Scalar() == "none") {
+        s.limb_darkening_file.reset();
+      } else {
+        YamlMap m = ld->ToMap("'none' or {file: <Neckel & Labs coefficient table>}");
+        s.limb_darkening_file = m.Path("file");
+        m.Finish();
+      }
+    }
+    sun->Finish();
+    spec.sun = s;
+  }
   root.Finish();
 
   // Cross-field checks.
@@ -137,7 +230,8 @@ AtmosphereSpec LoadAtmosphere(const std::filesystem::path& path) {
 void RequireSections(const AtmosphereSpec& spec, const std::vector<std::string>& sections) {
   Diagnostics d;
   for (const std::string& s : sections) {
-    bool present = (s == "planet" && spec.planet) || (s == "grid" && spec.grid) || (s == "air" && spec.air);
+    bool present = (s == "planet" && spec.planet) || (s == "grid" && spec.grid) || (s == "air" && spec.air) ||
+                   (s == "ozone" && spec.ozone) || (s == "ground" && spec.ground) || (s == "sun" && spec.sun);
     if (!present) d.Add(FileLoc{spec.file.string(), 0}, "missing section '" + s + "'");
   }
   d.ThrowIfAny();
@@ -148,12 +242,7 @@ std::string CanonicalProfilesYaml(const AtmosphereSpec& spec, const std::filesys
   out << YAML::Comment("canonical profile component of " + spec.name + " (written by skybake; do not edit)");
   out << YAML::BeginMap;
   out << YAML::Key << "name" << YAML::Value << spec.name;
-  if (spec.planet) {
-    out << YAML::Key << "planet" << YAML::Value << YAML::BeginMap;
-    out << YAML::Key << "radius_km" << YAML::Value << FormatExact(spec.planet->radius_m / 1e3);
-    out << YAML::Key << "top_km" << YAML::Value << FormatExact(spec.planet->top_m / 1e3);
-    out << YAML::EndMap;
-  }
+  EmitPlanet(out, spec);
   if (spec.grid) {
     out << YAML::Key << "grid" << YAML::Value << YAML::BeginMap;
     out << YAML::Key << "altitude_step_m" << YAML::Value << FormatExact(spec.grid->altitude_step_m);
@@ -185,6 +274,91 @@ std::string CanonicalProfilesYaml(const AtmosphereSpec& spec, const std::filesys
       out << YAML::EndMap;
     }
     out << YAML::EndSeq;
+  }
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+}  // namespace skybake
+
+namespace skybake {
+
+std::string CanonicalRenderYaml(const AtmosphereSpec& spec, const std::filesystem::path& dir) {
+  YAML::Emitter out;
+  out << YAML::Comment("canonical render component of " + spec.name + " (written by skybake; do not edit)");
+  out << YAML::BeginMap;
+  out << YAML::Key << "name" << YAML::Value << spec.name;
+  EmitPlanet(out, spec);
+  out << YAML::Key << "observer" << YAML::Value << YAML::BeginMap << YAML::Key << "altitude_km" << YAML::Value
+      << FormatExact(spec.observer_altitude_m / 1e3) << YAML::EndMap;
+  if (spec.air) {
+    out << YAML::Key << "air" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "profile" << YAML::Value;
+    EmitProfile(out, spec.air->profile, dir);  // kind only matters for provenance; densities come from profiles.exr
+    out << YAML::Key << "co2_ppm" << YAML::Value << FormatExact(spec.air->co2_ppm);
+    out << YAML::EndMap;
+  }
+  if (spec.ozone) {
+    out << YAML::Key << "ozone" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "profile" << YAML::Value;
+    EmitProfile(out, spec.ozone->profile, dir);
+    if (spec.ozone->column_du) out << YAML::Key << "column_du" << YAML::Value << FormatExact(*spec.ozone->column_du);
+    if (spec.ozone->cross_section) {
+      const OzoneCrossSectionSpec& c = *spec.ozone->cross_section;
+      out << YAML::Key << "cross_section" << YAML::Value << YAML::BeginMap;
+      if (c.kind == OzoneCrossSectionSpec::Kind::kTable) {
+        out << YAML::Key << "table" << YAML::Value;
+        EmitSpectralTable(out, c.table, dir);
+      } else {
+        out << YAML::Key << "bogumil2003" << YAML::Value << YAML::BeginMap;
+        out << YAML::Key << "file" << YAML::Value << c.bogumil_file.lexically_relative(dir).generic_string();
+        out << YAML::Key << "temperature_K" << YAML::Value << (c.temperature_k ? FormatExact(*c.temperature_k) : std::string("local"));
+        out << YAML::EndMap;
+      }
+      out << YAML::EndMap;
+    }
+    out << YAML::EndMap;
+  }
+  if (!spec.aerosols.empty()) {
+    out << YAML::Key << "aerosols" << YAML::Value << YAML::BeginSeq;
+    for (const AerosolLayerSpec& a : spec.aerosols) {
+      out << YAML::BeginMap;
+      out << YAML::Key << "name" << YAML::Value << a.name;
+      if (a.particle) out << YAML::Key << "particle" << YAML::Value << a.particle->lexically_relative(dir).generic_string();
+      out << YAML::Key << "profile" << YAML::Value;
+      EmitProfile(out, a.profile, dir);
+      if (a.scale) {
+        out << YAML::Key << "scale" << YAML::Value << YAML::BeginMap;
+        if (a.scale->kind == AerosolScale::Kind::kOpticalDepth550nm) {
+          out << YAML::Key << "optical_depth_550nm" << YAML::Value << FormatExact(a.scale->value);
+        } else {
+          out << YAML::Key << "peak_number_density_cm3" << YAML::Value << FormatExact(a.scale->value * 1e-6);
+        }
+        out << YAML::EndMap;
+      }
+      out << YAML::EndMap;
+    }
+    out << YAML::EndSeq;
+  }
+  if (spec.ground) {
+    out << YAML::Key << "ground" << YAML::Value << YAML::BeginMap << YAML::Key << "albedo" << YAML::Value;
+    if (spec.ground->albedo_table) EmitSpectralTable(out, *spec.ground->albedo_table, dir);
+    else out << FormatExact(spec.ground->albedo.value_or(0.0));
+    out << YAML::EndMap;
+  }
+  if (spec.sun) {
+    out << YAML::Key << "sun" << YAML::Value << YAML::BeginMap;
+    out << YAML::Key << "spectrum" << YAML::Value;
+    EmitSpectralTable(out, spec.sun->spectrum, dir);
+    out << YAML::Key << "angular_diameter_deg" << YAML::Value << FormatExact(spec.sun->angular_diameter_deg);
+    out << YAML::Key << "limb_darkening" << YAML::Value;
+    if (spec.sun->limb_darkening_file) {
+      out << YAML::BeginMap << YAML::Key << "file" << YAML::Value
+          << spec.sun->limb_darkening_file->lexically_relative(dir).generic_string() << YAML::EndMap;
+    } else {
+      out << "none";
+    }
+    out << YAML::EndMap;
   }
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";

@@ -38,15 +38,41 @@ struct GridSpec {
   double altitude_step_m = 100.0;
 };
 
+// A spectral quantity tabulated in a CSV file: a wavelength column (unit from its suffix, _nm or
+// _um) and a value column; `where` selects rows of long-format tables (e.g. surface = grass).
+struct SpectralTableRef {
+  std::filesystem::path file;
+  std::string wavelength_column;
+  std::string value_column;
+  std::optional<std::pair<std::string, std::string>> where;  // {column, value}
+};
+
 struct AirSpec {
   ProfileSpec profile = Ussa1976Profile{};
+  // CO2 mixing ratio for the Rayleigh cross-section (Bodhaine et al. 1999 eq. 19), ppm by volume.
+  // Default 360 ppm, the value of Bodhaine's published tables; the effect of 360 -> 420 ppm on
+  // sigma is +1.6e-5 relative.
+  double co2_ppm = 360.0;
   // For exponential air: number density at the base altitude (m^-3). Default: USSA76 at sea
   // level, 2.54697e25 m^-3 (computed from the USSA76 constants, atmosphere/ussa1976.h).
   double surface_number_density_m3 = 2.54697e25;
 };
 
+// Ozone absorption cross-section: a fixed table, or the Bogumil et al. (2003) quadratic
+// temperature fit sigma(T) = (C0 + C1 (T - 273.15) + C2 (T - 273.15)^2) 1e-20 cm^2 evaluated at
+// a fixed temperature or at the local air temperature of each level (clamped to the fit's
+// validity, 203-293 K).
+struct OzoneCrossSectionSpec {
+  enum class Kind { kTable, kBogumil2003 };
+  Kind kind = Kind::kBogumil2003;
+  SpectralTableRef table;               // kTable: value column in _cm2 or _m2
+  std::filesystem::path bogumil_file;   // kBogumil2003: columns wavelength_*_nm, C0_*, C1_*, C2_*
+  std::optional<double> temperature_k;  // kBogumil2003: nullopt = local air temperature
+};
+
 struct OzoneSpec {
   ProfileSpec profile = TentProfile{};
+  std::optional<OzoneCrossSectionSpec> cross_section;
   // Total column in Dobson units (1 DU = 2.6867e20 molecules m^-2); the profile is rescaled to
   // it. Without it a table profile keeps its absolute values (it must then be a number density).
   std::optional<double> column_du;
@@ -65,6 +91,21 @@ struct AerosolLayerSpec {
   std::optional<AerosolScale> scale;
 };
 
+// Lambertian ground: a constant spectral albedo or a table.
+struct GroundSpec {
+  std::optional<double> albedo;
+  std::optional<SpectralTableRef> albedo_table;
+};
+
+// The sun: extraterrestrial spectral irradiance at the top of the atmosphere (W m^-2 nm^-1),
+// angular diameter, and limb darkening I(mu)/I(1) = sum_k a_k(lambda) mu^k from a table of
+// coefficients (Neckel & Labs 1994) or none (a uniform disk).
+struct SunSpec {
+  SpectralTableRef spectrum;
+  double angular_diameter_deg = 0.5334;  // 2 x 0.2667 deg: 1 AU mean (Hillaire 2016 §4.1: 0.527-0.545 deg)
+  std::optional<std::filesystem::path> limb_darkening_file;
+};
+
 struct AtmosphereSpec {
   std::string name;
   std::filesystem::path file;  // where it was read from
@@ -74,6 +115,8 @@ struct AtmosphereSpec {
   std::optional<AirSpec> air;
   std::optional<OzoneSpec> ozone;
   std::vector<AerosolLayerSpec> aerosols;
+  std::optional<GroundSpec> ground;
+  std::optional<SunSpec> sun;
 
   // Altitudes (m) from the ground to the top of the atmosphere with the grid step (the last
   // step may be shorter so that the top is included exactly).
@@ -84,12 +127,18 @@ struct AtmosphereSpec {
 AtmosphereSpec LoadAtmosphere(const std::filesystem::path& path);
 AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& default_name);
 
-// Throws InputError(file) naming the first missing section among "planet", "grid", "air".
+// Throws InputError(file) naming every missing section among "planet", "grid", "air", "ozone",
+// "ground", "sun".
 void RequireSections(const AtmosphereSpec& spec, const std::vector<std::string>& sections);
 
 // The canonical component with what profile-import needs (name, planet, grid, air, ozone,
 // aerosol names and profiles), paths relative to `dir`. Comments and formatting of the source
 // do not survive, so an edit that changes neither leaves these bytes unchanged.
 std::string CanonicalProfilesYaml(const AtmosphereSpec& spec, const std::filesystem::path& dir);
+
+// The canonical component with what the renderers need besides the profiles (name, planet,
+// observer, air Rayleigh settings, ozone cross-section and column, aerosol names, particle files
+// and scales, ground, sun); paths relative to `dir`.
+std::string CanonicalRenderYaml(const AtmosphereSpec& spec, const std::filesystem::path& dir);
 
 }  // namespace skybake
