@@ -1,0 +1,431 @@
+#include "transport/path_tracer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <glm/geometric.hpp>
+
+#include "io/error.h"
+
+namespace skybake {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// Target shell thickness (m) by altitude: thin where the aerosol and the air are dense, thick
+// above. Only efficiency depends on this (majorants are exact for any shells).
+double ShellThickness(double altitude_m) {
+  if (altitude_m < 2000.0) return 250.0;
+  if (altitude_m < 6000.0) return 500.0;
+  if (altitude_m < 20000.0) return 1000.0;
+  if (altitude_m < 50000.0) return 2500.0;
+  return 5000.0;
+}
+
+// Distance along the unit direction d from p to the sphere of radius R: the exit (far) root
+// when inside, the entry (near) root otherwise; -1 when there is no intersection ahead.
+struct SphereHit {
+  double t;
+  bool hit;
+};
+
+SphereHit NearSphere(const glm::dvec3& p, const glm::dvec3& d, double radius) {
+  const double b = glm::dot(p, d);
+  const double c = glm::dot(p, p) - radius * radius;
+  const double disc = b * b - c;
+  if (disc < 0.0) return {0.0, false};
+  const double s = std::sqrt(disc);
+  const double t0 = -b - s;
+  if (t0 > 0.0) return {t0, true};
+  return {0.0, false};
+}
+
+double FarSphere(const glm::dvec3& p, const glm::dvec3& d, double radius) {
+  const double b = glm::dot(p, d);
+  const double c = glm::dot(p, p) - radius * radius;
+  const double disc = std::max(0.0, b * b - c);
+  return -b + std::sqrt(disc);
+}
+
+glm::dvec3 CosineHemisphere(const glm::dvec3& n, double u1, double u2) {
+  // Malley's method: uniform disk sample projected up (pdf = cos / pi).
+  const double mu = std::sqrt(std::max(0.0, 1.0 - u1));
+  return RotateAround(n, mu, 2.0 * kPi * u2);
+}
+
+}  // namespace
+
+glm::dvec3 DirectionFromAngles(double zenith, double azimuth) {
+  return {std::sin(zenith) * std::cos(azimuth), std::sin(zenith) * std::sin(azimuth), std::cos(zenith)};
+}
+
+glm::dvec3 RotateAround(const glm::dvec3& axis, double mu, double phi) {
+  // Frisvad-style branchless basis (Duff et al. 2017, "Building an orthonormal basis, revisited").
+  const double sign = std::copysign(1.0, axis.z);
+  const double a = -1.0 / (sign + axis.z);
+  const double b = axis.x * axis.y * a;
+  const glm::dvec3 t(1.0 + sign * axis.x * axis.x * a, sign * b, -sign * axis.x);
+  const glm::dvec3 bt(b, sign + axis.y * axis.y * a, -axis.y);
+  const double s = std::sqrt(std::max(0.0, 1.0 - mu * mu));
+  return glm::normalize(mu * axis + s * (std::cos(phi) * t + std::sin(phi) * bt));
+}
+
+PathTracer::PathTracer(const AtmosphereModel& model, std::vector<std::array<double, 3>> xyz_weights,
+                       PathTracerSettings settings)
+    : model_(model), xyz_weights_(std::move(xyz_weights)), settings_(settings) {
+  SKYBAKE_CHECK_EQ(xyz_weights_.size(), model_.wavelengths());
+  SKYBAKE_CHECK(settings_.wavelengths_per_path >= 1 && settings_.wavelengths_per_path <= kMaxWavelengths);
+  // Shells: runs of levels whose thickness reaches ShellThickness.
+  const std::vector<double>& z = model_.altitude_m;
+  size_t lo = 0;
+  while (lo + 1 < z.size()) {
+    size_t hi = lo + 1;
+    while (hi + 1 < z.size() && z[hi] - z[lo] < ShellThickness(z[lo])) ++hi;
+    shells_.push_back({lo, hi, model_.bottom_radius_m + z[lo], model_.bottom_radius_m + z[hi]});
+    lo = hi;
+  }
+  shells_.back().radius_hi = model_.top_radius_m;
+  const size_t nw = model_.wavelengths();
+  shell_majorant_.resize(shells_.size() * nw);
+  for (size_t s = 0; s < shells_.size(); ++s) {
+    for (size_t w = 0; w < nw; ++w) shell_majorant_[s * nw + w] = model_.MaxExtinction(shells_[s].level_lo, shells_[s].level_hi, w);
+  }
+}
+
+size_t PathTracer::ShellOf(double radius) const {
+  auto it = std::upper_bound(shells_.begin(), shells_.end(), radius,
+                             [](double r, const Shell& s) { return r < s.radius_lo; });
+  size_t s = it == shells_.begin() ? 0 : static_cast<size_t>(it - shells_.begin()) - 1;
+  return std::min(s, shells_.size() - 1);
+}
+
+double PathTracer::Majorant(size_t shell, const size_t* idx, int k) const {
+  const size_t nw = model_.wavelengths();
+  double m = 0.0;
+  for (int j = 0; j < k; ++j) m = std::max(m, shell_majorant_[shell * nw + idx[j]]);
+  return m;
+}
+
+double PathTracer::MixturePhase(const AtmosphereModel::Cell& cell, size_t wl, double mu) const {
+  double num = 0.0, den = 0.0;
+  for (size_t c = 0; c < model_.components.size(); ++c) {
+    if (!model_.components[c].phase) continue;
+    const double s = model_.ComponentScattering(c, cell, wl);
+    if (s <= 0.0) continue;
+    num += s * model_.components[c].phase->Eval(wl, mu);
+    den += s;
+  }
+  return den > 0.0 ? num / den : 0.0;
+}
+
+void PathTracer::Transmittance(const glm::dvec3& position, const glm::dvec3& direction, const size_t* idx, int k,
+                               Pcg32& rng, double* T) const {
+  for (int j = 0; j < k; ++j) T[j] = 1.0;
+  glm::dvec3 p = position;
+  size_t s = ShellOf(glm::length(p));
+  for (int guard = 0; guard < 100000; ++guard) {
+    const Shell& sh = shells_[s];
+    // Where the ray leaves this shell: through the inner sphere (if it goes down and hits it)
+    // or through the outer one.
+    SphereHit inner = NearSphere(p, direction, sh.radius_lo);
+    const bool down = inner.hit;
+    const double t_exit = down ? inner.t : FarSphere(p, direction, sh.radius_hi);
+    const double mu_bar = Majorant(s, idx, k);
+    double t = 0.0;
+    if (mu_bar > 0.0) {
+      for (;;) {
+        t -= std::log(1.0 - rng.Uniform()) / mu_bar;
+        if (t >= t_exit) break;
+        const glm::dvec3 x = p + t * direction;
+        const AtmosphereModel::Cell cell = model_.Locate(glm::length(x) - model_.bottom_radius_m);
+        double tmax = 0.0;
+        for (int j = 0; j < k; ++j) {
+          T[j] *= std::max(0.0, 1.0 - model_.Extinction(cell, idx[j]) / mu_bar);
+          tmax = std::max(tmax, T[j]);
+        }
+        // Russian roulette on tiny transmittances (unbiased: survivors are reweighted).
+        if (tmax < 1e-3) {
+          const double q = tmax / 1e-3;
+          if (rng.Uniform() >= q) {
+            for (int j = 0; j < k; ++j) T[j] = 0.0;
+            return;
+          }
+          for (int j = 0; j < k; ++j) T[j] /= q;
+        }
+      }
+    }
+    p += t_exit * direction;
+    if (down) {
+      if (s == 0) {  // the ground: the sun is hidden
+        for (int j = 0; j < k; ++j) T[j] = 0.0;
+        return;
+      }
+      --s;
+    } else {
+      if (s + 1 == shells_.size()) return;  // left the atmosphere
+      ++s;
+    }
+  }
+  throw InternalError("transmittance traversal did not terminate");
+}
+
+void PathTracer::SunNee(const glm::dvec3& x, const glm::dvec3& d, bool ground, const double* beta, const size_t* idx,
+                        int k, const glm::dvec3& sun, Pcg32& rng, double* L) const {
+  const SunModel& sm = model_.sun;
+  // Uniform direction in the disk's cone: pdf = 1 / Omega.
+  const double cos_max = std::cos(sm.angular_radius_rad);
+  const double mu_c = 1.0 - rng.Uniform() * (1.0 - cos_max);
+  const glm::dvec3 wl = RotateAround(sun, mu_c, 2.0 * kPi * rng.Uniform());
+  const double alpha = std::acos(std::clamp(mu_c, -1.0, 1.0));
+  const glm::dvec3 up = glm::normalize(x);
+  double geom[kMaxWavelengths];
+  if (ground) {
+    const double cos_l = glm::dot(up, wl);
+    if (cos_l <= 0.0) return;
+    for (int j = 0; j < k; ++j) geom[j] = model_.ground_albedo[idx[j]] / kPi * cos_l;
+  } else {
+    const AtmosphereModel::Cell cell = model_.Locate(glm::length(x) - model_.bottom_radius_m);
+    const double mu = glm::dot(d, wl);
+    for (int j = 0; j < k; ++j) geom[j] = MixturePhase(cell, idx[j], mu);
+  }
+  bool any = false;
+  for (int j = 0; j < k; ++j) any = any || (beta[j] * geom[j] != 0.0);
+  if (!any) return;
+  double T[kMaxWavelengths];
+  // Start the shadow ray a hair above the ground so that it does not re-hit it.
+  const glm::dvec3 origin = ground ? x + up * 1e-3 : x;
+  Transmittance(origin, wl, idx, k, rng, T);
+  const double omega = sm.SolidAngle();
+  for (int j = 0; j < k; ++j) L[j] += beta[j] * geom[j] * T[j] * sm.Radiance(idx[j], alpha) * omega;
+}
+
+void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, const size_t* idx, int k, Pcg32& rng,
+                           double* L) const {
+  double beta[kMaxWavelengths];
+  for (int j = 0; j < k; ++j) {
+    beta[j] = 1.0;
+    L[j] = 0.0;
+  }
+  const bool sun_mode = settings_.illumination == Illumination::kSun;
+  size_t s = ShellOf(glm::length(p));
+  for (int depth = 0; depth < 100000; ++depth) {
+    // ---- free flight to the next real scattering event, the ground, or space
+    enum class Event { kScatter, kGround, kEscape } event = Event::kEscape;
+    for (int guard = 0;; ++guard) {
+      if (guard > 1000000) throw InternalError("free-flight traversal did not terminate");
+      const Shell& sh = shells_[s];
+      SphereHit inner = NearSphere(p, d, sh.radius_lo);
+      const bool down = inner.hit;
+      const double t_exit = down ? inner.t : FarSphere(p, d, sh.radius_hi);
+      const double mu_bar = Majorant(s, idx, k);
+      double t = 0.0;
+      bool scattered = false;
+      if (mu_bar > 0.0) {
+        for (;;) {
+          t -= std::log(1.0 - rng.Uniform()) / mu_bar;
+          if (t >= t_exit) break;
+          const glm::dvec3 x = p + t * d;
+          const AtmosphereModel::Cell cell = model_.Locate(glm::length(x) - model_.bottom_radius_m);
+          double ms[kMaxWavelengths], mn[kMaxWavelengths];
+          double ps = 0.0, pn = 0.0;
+          for (int j = 0; j < k; ++j) {
+            ms[j] = model_.Scattering(cell, idx[j]);
+            mn[j] = std::max(0.0, mu_bar - model_.Extinction(cell, idx[j]));
+            ps += std::abs(beta[j] * ms[j]);
+            pn += std::abs(beta[j] * mn[j]);
+          }
+          if (ps + pn <= 0.0) return;  // every weight is zero
+          const double P_s = ps / (ps + pn);
+          if (rng.Uniform() < P_s) {
+            for (int j = 0; j < k; ++j) beta[j] *= ms[j] / (mu_bar * P_s);
+            p = x;
+            scattered = true;
+            break;
+          }
+          for (int j = 0; j < k; ++j) beta[j] *= mn[j] / (mu_bar * (1.0 - P_s));
+        }
+      }
+      if (scattered) {
+        event = Event::kScatter;
+        break;
+      }
+      p += t_exit * d;
+      if (down) {
+        if (s == 0) {
+          event = Event::kGround;
+          // Snap exactly onto the ground sphere.
+          p = glm::normalize(p) * model_.bottom_radius_m;
+          break;
+        }
+        --s;
+      } else {
+        if (s + 1 == shells_.size()) {
+          event = Event::kEscape;
+          break;
+        }
+        ++s;
+      }
+    }
+
+    if (event == Event::kEscape) {
+      if (!sun_mode) {
+        for (int j = 0; j < k; ++j) L[j] += beta[j];  // uniform radiance 1 from space
+      }
+      return;
+    }
+
+    if (event == Event::kGround) {
+      const glm::dvec3 n = glm::normalize(p);
+      if (sun_mode) SunNee(p, d, true, beta, idx, k, sun, rng, L);
+      // Cosine-weighted bounce: f cos / pdf = albedo.
+      double bmax = 0.0;
+      for (int j = 0; j < k; ++j) {
+        beta[j] *= model_.ground_albedo[idx[j]];
+        bmax = std::max(bmax, beta[j]);
+      }
+      if (bmax <= 0.0) return;
+      d = CosineHemisphere(n, rng.Uniform(), rng.Uniform());
+      p += n * 1e-3;  // leave the surface
+      s = 0;
+    } else {
+      // Medium scattering vertex.
+      if (sun_mode) SunNee(p, d, false, beta, idx, k, sun, rng, L);
+      const AtmosphereModel::Cell cell = model_.Locate(glm::length(p) - model_.bottom_radius_m);
+      // Component choice ~ sum_j |b_j| mu_s,c(lambda_j); direction from that component's phase
+      // at the hero wavelength; weight by each wavelength's mixture phase / mixture pdf.
+      const size_t nc = model_.components.size();
+      double sel[32];
+      SKYBAKE_CHECK_LE(nc, size_t{32});
+      double total = 0.0;
+      for (size_t c = 0; c < nc; ++c) {
+        sel[c] = 0.0;
+        if (!model_.components[c].phase) continue;
+        for (int j = 0; j < k; ++j) sel[c] += std::abs(beta[j]) * model_.ComponentScattering(c, cell, idx[j]);
+        total += sel[c];
+      }
+      if (total <= 0.0) return;
+      double u = rng.Uniform() * total;
+      size_t chosen = 0;
+      for (size_t c = 0; c < nc; ++c) {
+        if (sel[c] <= 0.0) continue;
+        chosen = c;
+        if (u < sel[c]) break;
+        u -= sel[c];
+      }
+      const size_t hero = idx[0];
+      const double mu = model_.components[chosen].phase->SampleMu(hero, rng.Uniform());
+      const glm::dvec3 d_new = RotateAround(d, mu, 2.0 * kPi * rng.Uniform());
+      // Mixture pdf (solid angle) of the sampled direction.
+      double pdf = 0.0;
+      for (size_t c = 0; c < nc; ++c) {
+        if (sel[c] > 0.0) pdf += sel[c] / total * model_.components[c].phase->Eval(hero, mu);
+      }
+      if (!(pdf > 0.0)) return;
+      for (int j = 0; j < k; ++j) beta[j] *= MixturePhase(cell, idx[j], mu) / pdf;
+      d = d_new;  // the vertex is inside shell s: the traversal continues from there
+    }
+
+    // Russian roulette.
+    if (depth + 1 >= settings_.russian_roulette_depth) {
+      double bmax = 0.0;
+      for (int j = 0; j < k; ++j) bmax = std::max(bmax, std::abs(beta[j]));
+      const double q = std::min(1.0, bmax);
+      if (q <= 0.0 || rng.Uniform() >= q) return;
+      for (int j = 0; j < k; ++j) beta[j] /= q;
+    }
+  }
+}
+
+ColorEstimate PathTracer::Estimate(const glm::dvec3& position, const glm::dvec3& direction,
+                                   const glm::dvec3& sun_direction, uint64_t stream, bool cosine_hemisphere) const {
+  const size_t n_wl = model_.wavelengths();
+  const int k = static_cast<int>(std::min<size_t>(static_cast<size_t>(settings_.wavelengths_per_path), n_wl));
+  const double scale = static_cast<double>(n_wl) / k;
+  // Welford accumulators for X, Y, Z.
+  double mean[3] = {0, 0, 0}, m2[3] = {0, 0, 0};
+  uint64_t n = 0;
+  const glm::dvec3 up = glm::normalize(position);
+  // An observer on the ground starts 1 mm above it (as ground bounces do), so that views below
+  // the horizon hit the ground at once.
+  glm::dvec3 start = position;
+  if (glm::length(start) < model_.bottom_radius_m + 1e-3) start = up * (model_.bottom_radius_m + 1e-3);
+  for (;;) {
+    for (uint64_t b = 0; b < settings_.batch_paths; ++b, ++n) {
+      Pcg32 rng(settings_.seed, stream, n);
+      size_t idx[kMaxWavelengths];
+      const size_t hero = std::min(n_wl - 1, static_cast<size_t>(rng.Uniform() * static_cast<double>(n_wl)));
+      for (int j = 0; j < k; ++j) idx[j] = (hero + static_cast<size_t>(j) * n_wl / static_cast<size_t>(k)) % n_wl;
+      glm::dvec3 d = direction;
+      double weight = 1.0;
+      if (cosine_hemisphere) {
+        d = CosineHemisphere(up, rng.Uniform(), rng.Uniform());
+        weight = kPi;  // E = pi E_cos[L]
+      }
+      double L[kMaxWavelengths];
+      TracePath(start, d, sun_direction, idx, k, rng, L);
+      double xyz[3] = {0, 0, 0};
+      for (int j = 0; j < k; ++j) {
+        for (int c = 0; c < 3; ++c) xyz[c] += scale * weight * xyz_weights_[idx[j]][static_cast<size_t>(c)] * L[j];
+      }
+      const double nn = static_cast<double>(n + 1);
+      for (int c = 0; c < 3; ++c) {
+        const double delta = xyz[c] - mean[c];
+        mean[c] += delta / nn;
+        m2[c] += delta * (xyz[c] - mean[c]);
+      }
+    }
+    if (n >= settings_.min_paths) {
+      const double var_y = n > 1 ? m2[1] / static_cast<double>(n - 1) : 0.0;
+      const double se_y = std::sqrt(var_y / static_cast<double>(n));
+      if (se_y <= settings_.target_relative_error * std::abs(mean[1]) || n >= settings_.max_paths) break;
+    }
+  }
+  ColorEstimate e;
+  e.paths = n;
+  for (int c = 0; c < 3; ++c) {
+    e.xyz[static_cast<size_t>(c)] = mean[c];
+    const double var = n > 1 ? m2[c] / static_cast<double>(n - 1) : 0.0;
+    e.xyz_stderr[static_cast<size_t>(c)] = std::sqrt(var / static_cast<double>(n));
+  }
+  return e;
+}
+
+ColorEstimate PathTracer::Radiance(const glm::dvec3& position, const glm::dvec3& direction,
+                                   const glm::dvec3& sun_direction, uint64_t stream) const {
+  return Estimate(position, direction, sun_direction, stream, false);
+}
+
+ColorEstimate PathTracer::Irradiance(const glm::dvec3& position, const glm::dvec3& sun_direction, uint64_t stream) const {
+  return Estimate(position, glm::normalize(position), sun_direction, stream, true);
+}
+
+void PathTracer::SpectralRadiance(const glm::dvec3& position, const glm::dvec3& direction,
+                                  const glm::dvec3& sun_direction, const std::vector<size_t>& wavelengths,
+                                  uint64_t paths, uint64_t stream, std::vector<double>* mean,
+                                  std::vector<double>* stderr_out) const {
+  const int k = static_cast<int>(wavelengths.size());
+  SKYBAKE_CHECK(k >= 1 && k <= kMaxWavelengths);
+  std::vector<double> m(static_cast<size_t>(k), 0.0), m2(static_cast<size_t>(k), 0.0);
+  glm::dvec3 start = position;
+  if (glm::length(start) < model_.bottom_radius_m + 1e-3) start = glm::normalize(position) * (model_.bottom_radius_m + 1e-3);
+  for (uint64_t n = 0; n < paths; ++n) {
+    Pcg32 rng(settings_.seed, stream, n);
+    double L[kMaxWavelengths];
+    TracePath(start, direction, sun_direction, wavelengths.data(), k, rng, L);
+    for (int j = 0; j < k; ++j) {
+      const double delta = L[j] - m[static_cast<size_t>(j)];
+      m[static_cast<size_t>(j)] += delta / static_cast<double>(n + 1);
+      m2[static_cast<size_t>(j)] += delta * (L[j] - m[static_cast<size_t>(j)]);
+    }
+  }
+  mean->assign(m.begin(), m.end());
+  stderr_out->resize(static_cast<size_t>(k));
+  for (int j = 0; j < k; ++j) {
+    const double var = paths > 1 ? m2[static_cast<size_t>(j)] / static_cast<double>(paths - 1) : 0.0;
+    (*stderr_out)[static_cast<size_t>(j)] = std::sqrt(var / static_cast<double>(paths));
+  }
+}
+
+}  // namespace skybake

@@ -1,0 +1,131 @@
+// The reference renderer: a spectral Monte-Carlo path tracer for the layered spherical
+// atmosphere (GT7 "skysim" class; ../shared/seeds/gt7-sky-talk.txt, "Skysim": full-spectrum
+// path tracing, ratio tracking, importance sampling).
+//
+// Estimator (docs/sky-render.md has the derivation):
+//  - Wavelengths. Each path carries K wavelengths of the render grid (N samples): a uniformly
+//    random "hero" index h and h + floor(j N / K) mod N, j < K (hero wavelength sampling, Wilkie
+//    et al. 2014). Each grid index appears with probability K/N, so
+//    XYZ ~ (N/K) sum_j w(lambda_j) L(lambda_j) is an unbiased estimate of the grid sum
+//    sum_i w_i L_i, where w_i are the colour-matching weights (spectrum/xyz.h).
+//  - Free flights: spectral tracking (Kutz, Habel, Li & Novak 2017, "Spectral and decomposition
+//    tracking for rendering heterogeneous volumes", §4) with a majorant per spherical shell,
+//    mu_bar = max over the shell's levels and the path's wavelengths of the extinction (exact,
+//    since coefficients are linear between levels). At a tentative collision the path scatters
+//    with probability P_s = avg_j |b_j mu_s,j| / (avg_j |b_j mu_s,j| + avg_j |b_j mu_n,j|) and
+//    the throughputs b_j are multiplied by mu_s,j / (mu_bar P_s) (scatter) or mu_n,j /
+//    (mu_bar (1 - P_s)) (null); absorption only lowers the weights (no absorption events).
+//    Unbiased for any positive probabilities.
+//  - Scattering: the next direction is sampled from the mixture of the components' phase
+//    functions at the hero wavelength with component probabilities proportional to
+//    sum_j b_j mu_s,c(lambda_j); each wavelength is weighted by its own mixture phase / pdf.
+//  - Sun: next-event estimation at every scattering and ground vertex, with a direction drawn
+//    uniformly in the solar disk's cone (limb darkening in the radiance), transmittance by
+//    ratio tracking (Cramer 1978; Novak et al. 2014) with the same shell majorants, zero when the
+//    shadow ray hits the planet (Earth's shadow). Paths that leave the atmosphere collect
+//    nothing in sun mode (so the sun is never counted twice); the sun disk itself is not part
+//    of the sky radiance (it is the separate direct-sun output).
+//  - Uniform illumination (white-furnace mode): paths that leave the atmosphere collect a
+//    constant radiance 1 W m^-2 sr^-1 nm^-1; no next-event estimation.
+//  - Ground: Lambertian with spectral albedo; NEE to the sun, then a cosine-weighted bounce
+//    (throughput x albedo).
+//  - All orders: Russian roulette after `russian_roulette_depth` vertices with survival
+//    probability min(1, max_j b_j), weights divided by it (unbiased).
+// Randomness: one PCG32 stream per (seed, stream id, path index): results do not depend on
+// threads or scheduling.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "atmosphere/model.h"
+#include "transport/random.h"
+
+namespace skybake {
+
+enum class Illumination { kSun, kUniform };
+
+struct PathTracerSettings {
+  Illumination illumination = Illumination::kSun;
+  int wavelengths_per_path = 4;
+  // Adaptive sampling stops when stderr(Y) <= target * mean(Y) (and at least min_paths).
+  double target_relative_error = 0.01;
+  uint64_t min_paths = 64;
+  uint64_t max_paths = uint64_t{1} << 20;
+  uint64_t batch_paths = 64;
+  int russian_roulette_depth = 4;
+  uint64_t seed = 1;
+};
+
+// Mean and standard error of an estimated colour (XYZ: cd/m^2 for radiance, lux for irradiance).
+struct ColorEstimate {
+  std::array<double, 3> xyz{0, 0, 0};
+  std::array<double, 3> xyz_stderr{0, 0, 0};
+  uint64_t paths = 0;
+};
+
+class PathTracer {
+ public:
+  // `xyz_weights[i]` are the colour-matching weights of grid wavelength i (e.g. 683 x̄ Δλ, ...).
+  PathTracer(const AtmosphereModel& model, std::vector<std::array<double, 3>> xyz_weights,
+             PathTracerSettings settings);
+
+  const AtmosphereModel& model() const { return model_; }
+  const PathTracerSettings& settings() const { return settings_; }
+
+  // Sky radiance (XYZ) at `position` (m, planet-centred) looking along `direction` (unit), with
+  // the sun centre along `sun_direction` (unit). Adaptive to the target error.
+  ColorEstimate Radiance(const glm::dvec3& position, const glm::dvec3& direction, const glm::dvec3& sun_direction,
+                         uint64_t stream) const;
+  // Irradiance from the sky on a horizontal surface at `position` (hemispherical integral of
+  // radiance x cos, XYZ: lux), by cosine-weighted view directions. Adaptive.
+  ColorEstimate Irradiance(const glm::dvec3& position, const glm::dvec3& sun_direction, uint64_t stream) const;
+  // Spectral radiance at the given grid wavelengths (every path carries all of them), with a
+  // fixed number of paths. Fills mean[j] and stderr[j] (W m^-2 sr^-1 nm^-1).
+  void SpectralRadiance(const glm::dvec3& position, const glm::dvec3& direction, const glm::dvec3& sun_direction,
+                        const std::vector<size_t>& wavelengths, uint64_t paths, uint64_t stream,
+                        std::vector<double>* mean, std::vector<double>* stderr_out) const;
+
+  // One path: L[j] for the k wavelengths idx[j] (k <= kMaxWavelengths).
+  void TracePath(glm::dvec3 position, glm::dvec3 direction, const glm::dvec3& sun_direction, const size_t* idx, int k,
+                 Pcg32& rng, double* L) const;
+  // Ratio-tracking transmittance from `position` along `direction` to the top of the
+  // atmosphere (0 if the ray hits the ground) for k wavelengths.
+  void Transmittance(const glm::dvec3& position, const glm::dvec3& direction, const size_t* idx, int k, Pcg32& rng,
+                     double* T) const;
+
+  static constexpr int kMaxWavelengths = 16;
+
+  // The shells used for majorants (exposed for tests and the report).
+  struct Shell {
+    size_t level_lo, level_hi;
+    double radius_lo, radius_hi;
+  };
+  const std::vector<Shell>& shells() const { return shells_; }
+
+ private:
+  ColorEstimate Estimate(const glm::dvec3& position, const glm::dvec3& direction, const glm::dvec3& sun_direction,
+                         uint64_t stream, bool cosine_hemisphere) const;
+  size_t ShellOf(double radius) const;
+  double Majorant(size_t shell, const size_t* idx, int k) const;
+  // Sun next-event estimate at a medium or ground vertex: adds to L.
+  void SunNee(const glm::dvec3& x, const glm::dvec3& d, bool ground, const double* beta, const size_t* idx, int k,
+              const glm::dvec3& sun, Pcg32& rng, double* L) const;
+  double MixturePhase(const AtmosphereModel::Cell& cell, size_t wl, double mu) const;
+
+  const AtmosphereModel& model_;
+  std::vector<std::array<double, 3>> xyz_weights_;
+  PathTracerSettings settings_;
+  std::vector<Shell> shells_;
+  std::vector<double> shell_majorant_;  // [shell * n_wl + wl]
+};
+
+// Orthonormal direction helpers.
+glm::dvec3 DirectionFromAngles(double zenith_rad, double azimuth_rad);  // z up, azimuth from +x
+// A direction with cosine `mu` to `axis` and azimuth `phi` around it.
+glm::dvec3 RotateAround(const glm::dvec3& axis, double mu, double phi);
+
+}  // namespace skybake
