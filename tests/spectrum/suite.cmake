@@ -1,0 +1,1 @@
+skybake_add_test_suite(NAME spectrum DEPS skybake_spectrum skybake_io)
