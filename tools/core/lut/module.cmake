@@ -1,0 +1,1 @@
+skybake_add_core_module(NAME lut DEPS skybake_io)
