@@ -1,0 +1,1 @@
+skybake_add_core_module(NAME noise DEPS skybake_io TBB::tbb)
