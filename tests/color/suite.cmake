@@ -1,0 +1,1 @@
+skybake_add_test_suite(NAME color DEPS skybake_color skybake_spectrum skybake_io)
