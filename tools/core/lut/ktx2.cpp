@@ -9,6 +9,7 @@
 
 #include "io/error.h"
 #include "io/fileio.h"
+#include "skybake/version.h"
 
 namespace skybake::ktx2 {
 
@@ -280,6 +281,16 @@ std::string Texture::GetString(const std::string& key) const {
 
 void SetString(Texture& texture, const std::string& key, const std::string& value) {
   texture.metadata[key] = value + std::string(1, '\0');
+}
+
+void SetProvenance(Texture& texture, const Provenance& p) {
+  texture.writer = "skybake " + p.tool + " " + kVersion;
+  SetString(texture, "skybake.tool", p.tool);
+  SetString(texture, "skybake.version", kVersion);
+  SetString(texture, "skybake.parameters", p.parameters);
+  std::string inputs;
+  for (const auto& [path, hash] : p.inputs) inputs += path + " xxh3:" + hash + "\n";
+  SetString(texture, "skybake.inputs", inputs);
 }
 
 std::string EncodeKtx2(const Texture& t) {

@@ -44,6 +44,8 @@
 #include <string_view>
 #include <vector>
 
+#include "io/exr.h"
+
 static_assert(std::endian::native == std::endian::little, "KTX2 writing assumes a little-endian host");
 
 namespace skybake::ktx2 {
@@ -174,6 +176,10 @@ struct Texture {
 
 // Sets metadata[key] to value + NUL (ktxspec: string values should be NUL terminated).
 void SetString(Texture& texture, const std::string& key, const std::string& value);
+// The provenance of an EXR product (io/exr.h SetProvenance) as key/value strings with the same
+// names and formats: skybake.tool, skybake.version, skybake.parameters, skybake.inputs; and
+// writer = "skybake <tool> <version>" (KTXwriter).
+void SetProvenance(Texture& texture, const Provenance& provenance);
 
 // Bytes of the encoded file. Throws InternalError if the texture is inconsistent (bad dimension
 // combination for ktxspec "Texture Type", wrong data size, reserved or duplicate keys, empty writer).

@@ -408,7 +408,6 @@ GeneratedVolume GenerateVolume(const VolumeSpec& spec, const ProgressFn& progres
     out.range.push_back(range);
     out.normalised.push_back(ComputeStats(v, c));
   }
-  ReportProgress(progress, "noise", 1.0);
   return out;
 }
 
