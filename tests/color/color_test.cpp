@@ -273,3 +273,57 @@ TEST(ColorConfig, PathResolution) {
             "/nonexistent/env.ocio: cannot read the OCIO config (named by $SKYBAKE_OCIO)");
   ::unsetenv("SKYBAKE_OCIO");
 }
+
+// The renderer's path of docs/color.md §9, end to end: spectral radiance on a 5 nm grid -> XYZ
+// (CIE 2006 weights) -> Linear Rec.2020 through OCIO -> sRGB preview. Pixel 0 is D65 light
+// (neutral: R = G = B in the PNG), pixel 1 is a 5778 K blackbody scaled to the same luminance
+// (warmer than D65: R > B); with white_cd_m2 = 2·Y both sit mid-grey-ish, below clipping.
+TEST(Preview, RendererPathEndToEnd) {
+  const WavelengthGrid grid = WavelengthGrid::Uniform(360, 825, 5);  // D65 is tabulated to 830 nm
+  const XyzWeights w(grid, LoadedCmf(kDefaultObserver));
+  Spectrum d65 = Resample(LoadSpectrumColumn(DataFile("cie_d65_1nm.csv"), "relative_spd"), grid);
+  std::vector<double> sun(grid.size());
+  for (size_t i = 0; i < grid.size(); ++i) {
+    const double l = grid[i] * 1e-9, h = 6.62607015e-34, c = 2.99792458e8, kb = 1.380649e-23;
+    sun[i] = 2 * h * c * c / std::pow(l, 5) / std::expm1(h * c / (l * kb * 5778.0)) * 1e-9;
+  }
+  const Xyz a = w.Integrate(d65.values);
+  Xyz b = w.Integrate(sun);
+  const double s = a.Y / b.Y;
+  b = Xyz{b.X * s, b.Y * s, b.Z * s};
+  std::vector<float> pixels{static_cast<float>(a.X), static_cast<float>(a.Y), static_cast<float>(a.Z),
+                            static_cast<float>(b.X), static_cast<float>(b.Y), static_cast<float>(b.Z)};
+  Config().Converter(XyzColorSpace(w.observer()), ocio_names::kLinearRec2020).Apply(pixels);
+  const fs::path png = fs::path(::testing::TempDir()) / "skybake_renderer_path.png";
+  WritePreviewPng(png, 2, 1, pixels, Config().Display(ocio_names::kLinearRec2020, {.white_cd_m2 = 2.0 * a.Y}));
+  int pw = 0, ph = 0, pc = 0;
+  std::vector<uint8_t> px = DecodePng8(ReadFileBytes(png), png.string(), &pw, &ph, &pc);
+  ASSERT_EQ(px.size(), 6u);
+  // Neutral within one code: on the 5 nm grid D65 is neutral to ~5e-5 in chromaticity (exactly
+  // only with the 1 nm sums of the config's mapping), and 0.7354·255 = 187.5 sits on a rounding edge.
+  EXPECT_NEAR(px[0], px[1], 1);
+  EXPECT_NEAR(px[1], px[2], 1);
+  EXPECT_NEAR(px[1], 188, 1);  // Y = white/2 -> sRGB code 0.7354 -> 187.5 (IEC 61966-2-1)
+  EXPECT_GT(px[3], px[5] + 5);
+}
+
+// The exposure is exact whatever its size: c·k through the view equals c through the view at
+// k = 1, for white_cd_m2 from 1e-3 to 1e9 cd/m² (absolute skies and the sun need k down to
+// 1e-9). OCIO 2.1.2 loses such small scales when it composes matrices, so color.h applies k
+// itself; this guards that.
+TEST(Preview, ExposureIsExactOverManyStops) {
+  const std::array<float, 3> c{0.2f, 0.5f, 0.05f};
+  const std::array<float, 3> ref = Config().Display(ocio_names::kLinearRec2020, DisplayView{}).Apply(c);
+  for (double white : {1e-3, 1.0, 1e2, 1e4, 1e6, 1e7, 1e9}) {
+    ColorProcessor p = Config().Display(ocio_names::kLinearRec2020, DisplayView{.white_cd_m2 = white});
+    std::array<float, 3> in{static_cast<float>(c[0] * white), static_cast<float>(c[1] * white),
+                            static_cast<float>(c[2] * white)};
+    std::array<float, 3> out = p.Apply(in);
+    std::vector<float> buffer(in.begin(), in.end());
+    p.Apply(buffer);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_NEAR(out[k], ref[k], 2e-6) << "white " << white << " channel " << k;
+      EXPECT_EQ(buffer[k], out[k]) << "buffer and pixel paths agree";
+    }
+  }
+}

@@ -35,6 +35,13 @@ double DisplayView::Scale() const { return std::exp2(exposure_stops) / white_cd_
 
 struct ColorProcessor::Impl {
   OCIO::ConstCPUProcessorRcPtr cpu;
+  // A uniform scale applied before the OCIO processor (the preview exposure k), 1 otherwise.
+  // Not an OCIO MatrixTransform: observed with OCIO 2.1.2, composing matrices
+  // (OPTIMIZATION_COMP_MATRIX, part of LOSSLESS) drops entries of the product below ~1e-7, so
+  // diag(1e-7) followed by Linear Rec.2020 -> XYZ turned (5e6, 5e6, 5e6) into (0, 0, 0.53)
+  // instead of (0.475, 0.5, 0.545), and 1e-6 shifted the hue. Absolute skies need k ~ 1e-4 to
+  // 1e-9, so the scale is applied here, in double (tests/color Preview.ExposureIsExactOverManyStops).
+  double scale = 1.0;
   std::string description;
   std::string cache_id;
 };
@@ -51,7 +58,11 @@ void ColorProcessor::Apply(std::span<float> rgb) const {
   const size_t pixels = rgb.size() / 3;
   if (pixels == 0) return;
   const OCIO::ConstCPUProcessorRcPtr& cpu = impl_->cpu;
+  const double scale = impl_->scale;
   auto run = [&](size_t begin, size_t end) {
+    if (scale != 1.0) {
+      for (size_t i = begin * 3; i < end * 3; ++i) rgb[i] = static_cast<float>(static_cast<double>(rgb[i]) * scale);
+    }
     OCIO::PackedImageDesc desc(rgb.data() + begin * 3, static_cast<long>(end - begin), 1, 3);
     cpu->apply(desc);
   };
@@ -65,6 +76,9 @@ void ColorProcessor::Apply(std::span<float> rgb) const {
 
 std::array<float, 3> ColorProcessor::Apply(std::array<float, 3> rgb) const {
   if (!impl_) throw InternalError("ColorProcessor::Apply on an empty processor");
+  if (impl_->scale != 1.0) {
+    for (float& v : rgb) v = static_cast<float>(static_cast<double>(v) * impl_->scale);
+  }
   impl_->cpu->applyRGB(rgb.data());
   return rgb;
 }
@@ -190,23 +204,18 @@ ColorProcessor ColorConfig::Display(std::string_view src, const DisplayView& vie
                                         view.white_cd_m2));
   }
   auto impl = std::make_shared<ColorProcessor::Impl>();
+  // The exposure is a uniform scale of linear values, so it commutes with the linear source
+  // space; it is applied by Apply before the OCIO display view (see Impl::scale).
+  impl->scale = k;
   try {
-    // exposure (a uniform scale of linear values, so it commutes with the linear source space)
-    // followed by the display view.
-    OCIO::GroupTransformRcPtr group = OCIO::GroupTransform::Create();
-    OCIO::MatrixTransformRcPtr exposure = OCIO::MatrixTransform::Create();
-    const double m44[16] = {k, 0, 0, 0, 0, k, 0, 0, 0, 0, k, 0, 0, 0, 0, 1};
-    exposure->setMatrix(m44);
-    group->appendTransform(exposure);
     OCIO::DisplayViewTransformRcPtr dv = OCIO::DisplayViewTransform::Create();
     dv->setSrc(s.c_str());
     dv->setDisplay(view.display.c_str());
     dv->setView(view.view.c_str());
-    group->appendTransform(dv);
     std::lock_guard<std::mutex> lock(impl_->mutex);
-    OCIO::ConstProcessorRcPtr p = impl_->config->getProcessor(group);
+    OCIO::ConstProcessorRcPtr p = impl_->config->getProcessor(dv);
     impl->cpu = p->getOptimizedCPUProcessor(OCIO::BIT_DEPTH_F32, OCIO::BIT_DEPTH_F32, OCIO::OPTIMIZATION_LOSSLESS);
-    impl->cache_id = p->getCacheID();
+    impl->cache_id = fmt::format("{} scale {}", p->getCacheID(), k);
   } catch (const OCIO::Exception& e) {
     throw InputError(where, fmt::format("OCIO: {} -> {}/{}: {}", s, view.display, view.view, e.what()));
   }

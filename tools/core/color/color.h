@@ -117,7 +117,9 @@ class ColorConfig {
   // listing the known ones.
   ColorProcessor Converter(std::string_view src, std::string_view dst) const;
   // src (a scene-referred, non-data space) -> display/view, after the exposure scale k. The
-  // output is display-encoded (0-1 code values).
+  // output is display-encoded (0-1 code values). k is applied by Apply in double before the OCIO
+  // processor (a uniform scale, not a colour conversion): OCIO 2.1.2's matrix composition loses
+  // scales below ~1e-7, which absolute skies need (color.cpp).
   ColorProcessor Display(std::string_view src, const DisplayView& view) const;
 
  private:
