@@ -70,7 +70,7 @@ WavelengthGrid WavelengthGrid::Rgb() {
   WavelengthGrid g;
   g.kind_ = Kind::kRgb;
   // Red, green, blue: Hillaire 2016 (../shared/seeds/hillaire2016-frostbite-sky-clouds.txt,
-  // "red (680nm), green (550nm) and blue (440nm)"), Bruneton & Neyret 2008 §4 (680, 550, 440 nm).
+  // "red (680nm), green (550nm) and blue (440nm)"), Bruneton & Neyret 2008 §2.1 (680, 550, 440 nm).
   g.wavelength_nm_ = {680.0, 550.0, 440.0};
   for (double w : g.wavelength_nm_) {
     g.bin_lo_nm_.push_back(w - 0.5 * kRgbBinWidthNm);

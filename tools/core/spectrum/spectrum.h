@@ -12,8 +12,9 @@
 //     trapezoid integral of the table over [lo_0, hi_{n-1}] (conservation; tests check it to
 //     1e-12). Use it for data finer than the grid (the ASTM G173 solar spectrum at 0.5-1 nm onto
 //     a 5 nm grid: each 5 nm sample is the mean irradiance of its bin [λ-2.5, λ+2.5] nm).
-//     Note: Bruneton 2017's demo averages the *samples* in [λ, λ+10) instead (a left-Riemann
-//     reading of the table); its 10 nm solar values differ from these by up to ~0.5 %.
+//     Note: Bruneton 2017's demo averages the *samples* in [λ, λ+10) instead (not centred, and
+//     a mean of samples rather than an integral); on the same bins the two averages of ASTM G173
+//     differ by up to 1.9 % (computed, docs/color.md §2).
 //   kLinear: f_i = f(λ_i), the interpolant at the sample (data as fine as or coarser than the
 //     grid; exact on the table's own points).
 //   kAuto: kBinAverage when the table resolves every bin, i.e. its largest spacing inside the
