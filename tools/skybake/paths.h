@@ -17,4 +17,19 @@ inline std::filesystem::path Profiles(const std::string& atm) {
   return std::filesystem::path(atm) / "profiles.exr";
 }
 
+// outputs/clouds/noise/<volume><ext>: noise-gen's volume (the recipe file's stem), ext ".ktx2"
+// (the product), ".exr" (float field) or ".png" (slice montage).
+inline std::filesystem::path CloudNoise(const std::string& volume, const std::string& ext) {
+  return std::filesystem::path("clouds") / "noise" / (volume + ext);
+}
+// outputs/clouds/cumulus_map_t<time>s<ext>: cumulus-map's map at `time` seconds (shortest
+// round-trip decimal, e.g. "600"), ext ".ktx2", ".exr" or ".png".
+inline std::filesystem::path CumulusMap(const std::string& time_s, const std::string& ext) {
+  return std::filesystem::path("clouds") / ("cumulus_map_t" + time_s + "s" + ext);
+}
+// outputs/clouds/coverage<ext>: cumulus-map's coverage texture.
+inline std::filesystem::path CoverageTexture(const std::string& ext) {
+  return std::filesystem::path("clouds") / ("coverage" + ext);
+}
+
 }  // namespace skybake::paths
