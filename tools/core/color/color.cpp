@@ -91,7 +91,8 @@ const std::string& ColorProcessor::cache_id() const { return impl_ ? impl_->cach
 struct ColorConfig::Impl {
   fs::path path;
   OCIO::ConstConfigRcPtr config;
-  std::mutex mutex;  // OCIO issue #1216: one processor build at a time
+  // OCIO issue #1216: one thread at a time inside the Config (recursive: error paths list names).
+  std::recursive_mutex mutex;
 };
 
 fs::path ColorConfig::ResolvePath(const fs::path& explicit_path) {
@@ -125,23 +126,26 @@ ColorConfig ColorConfig::Load(const fs::path& explicit_path) {
 
 const fs::path& ColorConfig::path() const { return impl_->path; }
 std::string ColorConfig::cache_id() const {
-  std::lock_guard<std::mutex> lock(impl_->mutex);
+  std::lock_guard<std::recursive_mutex> lock(impl_->mutex);
   return impl_->config->getCacheID();
 }
 
 std::vector<std::string> ColorConfig::ColorSpaces() const {
+  std::lock_guard<std::recursive_mutex> lock(impl_->mutex);
   std::vector<std::string> out;
   for (int i = 0; i < impl_->config->getNumColorSpaces(); ++i) out.emplace_back(impl_->config->getColorSpaceNameByIndex(i));
   return out;
 }
 
 std::vector<std::string> ColorConfig::Displays() const {
+  std::lock_guard<std::recursive_mutex> lock(impl_->mutex);
   std::vector<std::string> out;
   for (int i = 0; i < impl_->config->getNumDisplays(); ++i) out.emplace_back(impl_->config->getDisplay(i));
   return out;
 }
 
 std::vector<std::string> ColorConfig::Views(const std::string& display) const {
+  std::lock_guard<std::recursive_mutex> lock(impl_->mutex);
   std::vector<std::string> out;
   for (int i = 0; i < impl_->config->getNumViews(display.c_str()); ++i) {
     out.emplace_back(impl_->config->getView(display.c_str(), i));
@@ -158,6 +162,7 @@ std::string Quoted(const std::vector<std::string>& names) {
 }  // namespace
 
 ColorProcessor ColorConfig::Converter(std::string_view src, std::string_view dst) const {
+  std::lock_guard<std::recursive_mutex> lock(impl_->mutex);
   const std::string s(src), d(dst);
   for (const std::string& name : {s, d}) {
     if (!impl_->config->getColorSpace(name.c_str())) {
@@ -167,7 +172,6 @@ ColorProcessor ColorConfig::Converter(std::string_view src, std::string_view dst
   }
   auto impl = std::make_shared<ColorProcessor::Impl>();
   try {
-    std::lock_guard<std::mutex> lock(impl_->mutex);
     OCIO::ConstProcessorRcPtr p = impl_->config->getProcessor(s.c_str(), d.c_str());
     impl->cpu = p->getOptimizedCPUProcessor(OCIO::BIT_DEPTH_F32, OCIO::BIT_DEPTH_F32, OCIO::OPTIMIZATION_LOSSLESS);
     impl->cache_id = p->getCacheID();
@@ -181,6 +185,7 @@ ColorProcessor ColorConfig::Converter(std::string_view src, std::string_view dst
 }
 
 ColorProcessor ColorConfig::Display(std::string_view src, const DisplayView& view) const {
+  std::lock_guard<std::recursive_mutex> lock(impl_->mutex);
   const std::string s(src);
   const FileLoc where{impl_->path.string(), 0};
   OCIO::ConstColorSpaceRcPtr cs = impl_->config->getColorSpace(s.c_str());
@@ -212,7 +217,6 @@ ColorProcessor ColorConfig::Display(std::string_view src, const DisplayView& vie
     dv->setSrc(s.c_str());
     dv->setDisplay(view.display.c_str());
     dv->setView(view.view.c_str());
-    std::lock_guard<std::mutex> lock(impl_->mutex);
     OCIO::ConstProcessorRcPtr p = impl_->config->getProcessor(dv);
     impl->cpu = p->getOptimizedCPUProcessor(OCIO::BIT_DEPTH_F32, OCIO::BIT_DEPTH_F32, OCIO::OPTIMIZATION_LOSSLESS);
     impl->cache_id = fmt::format("{} scale {}", p->getCacheID(), k);

@@ -10,7 +10,7 @@
 //   WritePreviewPng("sky.png", width, height, pixels, view);
 //
 // Thread safety (OpenColorIO issue #1216: a Config must not be used from several threads while
-// it builds processors): ColorConfig serialises processor building with a mutex, and a
+// it builds processors): ColorConfig serialises every use of the OCIO Config with a mutex, and a
 // ColorProcessor is immutable, so Apply may run on many threads at once. Build processors once,
 // before the parallel part. Apply itself splits large buffers over TBB in fixed chunks; every
 // pixel is converted independently, so results do not depend on the thread count.
@@ -123,6 +123,7 @@ class ColorConfig {
   ColorProcessor Display(std::string_view src, const DisplayView& view) const;
 
  private:
+  ColorConfig() = default;  // only through Load: a ColorConfig always holds a valid config
   struct Impl;
   std::shared_ptr<Impl> impl_;
 };

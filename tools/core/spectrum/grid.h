@@ -70,7 +70,7 @@ class WavelengthGrid {
   std::string Describe() const;
 
   bool operator==(const WavelengthGrid& other) const {
-    return kind_ == other.kind_ && wavelength_nm_ == other.wavelength_nm_;
+    return kind_ == other.kind_ && step_nm_ == other.step_nm_ && wavelength_nm_ == other.wavelength_nm_;
   }
 
   // An empty grid (size 0), only so that structs holding a grid can be default-constructed;
