@@ -1,1 +1,1 @@
-skybake_add_core_module(NAME atmosphere DEPS skybake_optics skybake_io)
+skybake_add_core_module(NAME atmosphere DEPS skybake_optics skybake_spectrum skybake_io)

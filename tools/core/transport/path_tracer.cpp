@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <glm/geometric.hpp>
@@ -122,7 +123,13 @@ double PathTracer::MixturePhase(const AtmosphereModel::Cell& cell, size_t wl, do
 
 void PathTracer::Transmittance(const glm::dvec3& position, const glm::dvec3& direction, const size_t* idx, int k,
                                Pcg32& rng, double* T) const {
+  TransmittanceAlong(position, direction, std::numeric_limits<double>::infinity(), idx, k, rng, T);
+}
+
+void PathTracer::TransmittanceAlong(const glm::dvec3& position, const glm::dvec3& direction, double t_max,
+                                    const size_t* idx, int k, Pcg32& rng, double* T) const {
   for (int j = 0; j < k; ++j) T[j] = 1.0;
+  double travelled = 0.0;
   glm::dvec3 p = position;
   size_t s = ShellOf(glm::length(p));
   for (int guard = 0; guard < 100000; ++guard) {
@@ -131,7 +138,9 @@ void PathTracer::Transmittance(const glm::dvec3& position, const glm::dvec3& dir
     // or through the outer one.
     SphereHit inner = NearSphere(p, direction, sh.radius_lo);
     const bool down = inner.hit;
-    const double t_exit = down ? inner.t : FarSphere(p, direction, sh.radius_hi);
+    double t_exit = down ? inner.t : FarSphere(p, direction, sh.radius_hi);
+    const bool last = travelled + t_exit >= t_max;
+    if (last) t_exit = t_max - travelled;
     const double mu_bar = Majorant(s, idx, k);
     double t = 0.0;
     if (mu_bar > 0.0) {
@@ -156,7 +165,9 @@ void PathTracer::Transmittance(const glm::dvec3& position, const glm::dvec3& dir
         }
       }
     }
+    if (last) return;
     p += t_exit * direction;
+    travelled += t_exit;
     if (down) {
       if (s == 0) {  // the ground: the sun is hidden
         for (int j = 0; j < k; ++j) T[j] = 0.0;
@@ -201,6 +212,136 @@ void PathTracer::SunNee(const glm::dvec3& x, const glm::dvec3& d, bool ground, c
   for (int j = 0; j < k; ++j) L[j] += beta[j] * geom[j] * T[j] * sm.Radiance(idx[j], alpha) * omega;
 }
 
+
+void PathTracer::SegmentSunNee(const glm::dvec3& p, const glm::dvec3& d, const double* beta, const size_t* idx, int k,
+                               const glm::dvec3& sun, Pcg32& rng, double* L) const {
+  const double R = model_.bottom_radius_m, top = model_.top_radius_m;
+  const SphereHit g = NearSphere(p, d, R);
+  const double t_end = g.hit ? g.t : FarSphere(p, d, top);
+  if (!(t_end > 0.0)) return;
+  // Lit set along x(t) = p + t d: the planet hides the whole disk from x iff x.s < 0 and the
+  // distance of x from the shadow axis is below the planet radius, shrunk by the penumbra
+  // (angular radius x the longest sunlit chord through the atmosphere) so that points lit by
+  // part of the disk are kept (the estimator stays unbiased; NEE then finds the exact visibility).
+  const double margin = model_.sun.angular_radius_rad * std::sqrt(top * top - R * R) + 1.0;
+  const double rs = R - margin;
+  const double ps = glm::dot(p, sun), ds = glm::dot(d, sun);
+  auto lit = [&](double t) {
+    const glm::dvec3 x = p + t * d;
+    const double xs = glm::dot(x, sun);
+    return xs >= 0.0 || glm::dot(x, x) - xs * xs >= rs * rs;
+  };
+  double bp[6];
+  int nb = 0;
+  bp[nb++] = 0.0;
+  if (std::abs(ds) > 1e-15) {
+    const double t0 = -ps / ds;
+    if (t0 > 0.0 && t0 < t_end) bp[nb++] = t0;
+  }
+  {
+    const double a = 1.0 - ds * ds;
+    const double b = 2.0 * (glm::dot(p, d) - ps * ds);
+    const double c = glm::dot(p, p) - ps * ps - rs * rs;
+    if (a > 1e-15) {
+      const double disc = b * b - 4.0 * a * c;
+      if (disc > 0.0) {
+        const double sq = std::sqrt(disc);
+        for (double t : {(-b - sq) / (2.0 * a), (-b + sq) / (2.0 * a)}) {
+          if (t > 0.0 && t < t_end) bp[nb++] = t;
+        }
+      }
+    }
+  }
+  bp[nb++] = t_end;
+  std::sort(bp, bp + nb);
+  // Lit intervals and their total length.
+  double lit_lo[5], lit_hi[5];
+  int nl = 0;
+  double lit_len = 0.0;
+  for (int i = 0; i + 1 < nb; ++i) {
+    if (bp[i + 1] - bp[i] <= 0.0) continue;
+    if (lit(0.5 * (bp[i] + bp[i + 1]))) {
+      if (nl > 0 && lit_hi[nl - 1] == bp[i]) {
+        lit_hi[nl - 1] = bp[i + 1];
+      } else {
+        lit_lo[nl] = bp[i];
+        lit_hi[nl] = bp[i + 1];
+        ++nl;
+      }
+      lit_len += bp[i + 1] - bp[i];
+    }
+  }
+  if (nl == 0) return;
+  // Pieces over the lit part, weights ~ hero scattering x attenuation (midpoint rule), a
+  // piecewise-constant sampling density that is exactly known.
+  constexpr int kPieces = 64;
+  double piece_lo[kPieces + 5], piece_w[kPieces + 5], piece_len[kPieces + 5];
+  int np = 0;
+  const size_t hero = idx[0];
+  double tau = 0.0, t_prev = 0.0, total = 0.0;
+  auto extinction_at = [&](double t) {
+    const glm::dvec3 x = p + t * d;
+    return model_.Extinction(model_.Locate(glm::length(x) - R), hero);
+  };
+  for (int i = 0; i < nl; ++i) {
+    // Attenuation across the shadowed gap before this interval (4-point midpoint rule).
+    if (lit_lo[i] > t_prev) {
+      const double h = (lit_lo[i] - t_prev) / 4.0;
+      for (int q = 0; q < 4; ++q) tau += extinction_at(t_prev + (q + 0.5) * h) * h;
+    }
+    const int n = std::max(1, static_cast<int>(std::round(kPieces * (lit_hi[i] - lit_lo[i]) / lit_len)));
+    const double h = (lit_hi[i] - lit_lo[i]) / n;
+    for (int q = 0; q < n && np < kPieces + 5; ++q) {
+      const double tm = lit_lo[i] + (q + 0.5) * h;
+      const glm::dvec3 x = p + tm * d;
+      const AtmosphereModel::Cell cell = model_.Locate(glm::length(x) - R);
+      const double ext = model_.Extinction(cell, hero);
+      const double w = model_.Scattering(cell, hero) * std::exp(-(tau + 0.5 * ext * h)) * h;
+      tau += ext * h;
+      piece_lo[np] = lit_lo[i] + q * h;
+      piece_len[np] = h;
+      piece_w[np] = w;
+      total += w;
+      ++np;
+    }
+    t_prev = lit_hi[i];
+  }
+  if (!(total > 0.0)) return;
+  double u = rng.Uniform() * total;
+  int chosen = np - 1;
+  for (int i = 0; i < np; ++i) {
+    if (u < piece_w[i]) {
+      chosen = i;
+      break;
+    }
+    u -= piece_w[i];
+  }
+  if (piece_w[chosen] <= 0.0) return;
+  const double t_star = piece_lo[chosen] + rng.Uniform() * piece_len[chosen];
+  const double pdf = piece_w[chosen] / (total * piece_len[chosen]);
+  const glm::dvec3 x = p + t_star * d;
+  const AtmosphereModel::Cell cell = model_.Locate(glm::length(x) - R);
+  // Sun direction in the disk's cone.
+  const SunModel& sm = model_.sun;
+  const double cos_max = std::cos(sm.angular_radius_rad);
+  const double mu_c = 1.0 - rng.Uniform() * (1.0 - cos_max);
+  const glm::dvec3 wl = RotateAround(sun, mu_c, 2.0 * kPi * rng.Uniform());
+  const double alpha = std::acos(std::clamp(mu_c, -1.0, 1.0));
+  const double mu = glm::dot(d, wl);
+  double f[kMaxWavelengths];
+  bool any = false;
+  for (int j = 0; j < k; ++j) {
+    f[j] = beta[j] * model_.Scattering(cell, idx[j]) * MixturePhase(cell, idx[j], mu);
+    any = any || f[j] != 0.0;
+  }
+  if (!any) return;
+  double t_view[kMaxWavelengths], t_sun[kMaxWavelengths];
+  TransmittanceAlong(p, d, t_star, idx, k, rng, t_view);
+  Transmittance(x, wl, idx, k, rng, t_sun);
+  const double omega = sm.SolidAngle();
+  for (int j = 0; j < k; ++j) L[j] += f[j] * t_view[j] * t_sun[j] * sm.Radiance(idx[j], alpha) * omega / pdf;
+}
+
 void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, const size_t* idx, int k, Pcg32& rng,
                            double* L) const {
   double beta[kMaxWavelengths];
@@ -209,8 +350,13 @@ void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, co
     L[j] = 0.0;
   }
   const bool sun_mode = settings_.illumination == Illumination::kSun;
+  const bool segment_nee = sun_mode && settings_.segment_nee;
+  const int max_order = settings_.max_order > 0 ? settings_.max_order : std::numeric_limits<int>::max();
   size_t s = ShellOf(glm::length(p));
+  // `depth` = scattering and reflection events so far; a sun connection made now is of order
+  // depth + 1.
   for (int depth = 0; depth < 100000; ++depth) {
+    if (segment_nee && depth + 1 <= max_order) SegmentSunNee(p, d, beta, idx, k, sun, rng, L);
     // ---- free flight to the next real scattering event, the ground, or space
     enum class Event { kScatter, kGround, kEscape } event = Event::kEscape;
     for (int guard = 0;; ++guard) {
@@ -270,7 +416,7 @@ void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, co
     }
 
     if (event == Event::kEscape) {
-      if (!sun_mode) {
+      if (!sun_mode && depth <= max_order) {
         for (int j = 0; j < k; ++j) L[j] += beta[j];  // uniform radiance 1 from space
       }
       return;
@@ -278,7 +424,8 @@ void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, co
 
     if (event == Event::kGround) {
       const glm::dvec3 n = glm::normalize(p);
-      if (sun_mode) SunNee(p, d, true, beta, idx, k, sun, rng, L);
+      if (sun_mode && depth + 1 <= max_order) SunNee(p, d, true, beta, idx, k, sun, rng, L);
+      if (depth + 1 >= max_order && sun_mode) return;
       // Cosine-weighted bounce: f cos / pdf = albedo.
       double bmax = 0.0;
       for (int j = 0; j < k; ++j) {
@@ -291,7 +438,8 @@ void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, co
       s = 0;
     } else {
       // Medium scattering vertex.
-      if (sun_mode) SunNee(p, d, false, beta, idx, k, sun, rng, L);
+      if (sun_mode && !segment_nee && depth + 1 <= max_order) SunNee(p, d, false, beta, idx, k, sun, rng, L);
+      if (depth + 1 >= max_order && sun_mode) return;
       const AtmosphereModel::Cell cell = model_.Locate(glm::length(p) - model_.bottom_radius_m);
       // Component choice ~ sum_j |b_j| mu_s,c(lambda_j); direction from that component's phase
       // at the hero wavelength; weight by each wavelength's mixture phase / mixture pdf.
@@ -379,7 +527,11 @@ ColorEstimate PathTracer::Estimate(const glm::dvec3& position, const glm::dvec3&
     if (n >= settings_.min_paths) {
       const double var_y = n > 1 ? m2[1] / static_cast<double>(n - 1) : 0.0;
       const double se_y = std::sqrt(var_y / static_cast<double>(n));
-      if (se_y <= settings_.target_relative_error * std::abs(mean[1]) || n >= settings_.max_paths) break;
+      // An all-zero start (e.g. a view into the Earth's shadow) is not a converged estimate:
+      // keep sampling until the floor or max_paths decides.
+      const bool zero_so_far = mean[1] == 0.0 && m2[1] == 0.0;
+      const double tolerance = std::max(settings_.target_relative_error * std::abs(mean[1]), settings_.absolute_error_floor);
+      if ((!zero_so_far && se_y <= tolerance) || n >= settings_.max_paths) break;
     }
   }
   ColorEstimate e;

@@ -53,11 +53,24 @@ struct PathTracerSettings {
   int wavelengths_per_path = 4;
   // Adaptive sampling stops when stderr(Y) <= target * mean(Y) (and at least min_paths).
   double target_relative_error = 0.01;
+  // ... or when stderr(Y) <= this absolute floor (cd/m^2 for radiance, lux for irradiance): a
+  // texel darker than the floor need not be resolved relatively. 1e-5 cd/m^2 is ~100x below the
+  // natural night-sky luminance (~1e-3 cd/m^2).
+  double absolute_error_floor = 1e-5;
   uint64_t min_paths = 64;
   uint64_t max_paths = uint64_t{1} << 20;
   uint64_t batch_paths = 64;
   int russian_roulette_depth = 4;
   uint64_t seed = 1;
+  // Sun estimator. true: along every path segment, one point is drawn in the part of the
+  // segment that the sun can reach (a geometric test against the planet, widened by the disk's
+  // penumbra), with a density following the hero wavelength's scattering x attenuation, and
+  // the sun is connected from there ("segment NEE"); collisions then do no sun NEE. Unbiased,
+  // and it keeps twilight (where most of the medium is in the Earth's shadow) tractable.
+  // false: sun NEE at every collision only (the textbook estimator; kept to cross-check).
+  bool segment_nee = true;
+  // Highest scattering order counted (ground reflections count as orders); 0 = all orders.
+  int max_order = 0;
 };
 
 // Mean and standard error of an estimated colour (XYZ: cd/m^2 for radiance, lux for irradiance).
@@ -75,6 +88,7 @@ class PathTracer {
 
   const AtmosphereModel& model() const { return model_; }
   const PathTracerSettings& settings() const { return settings_; }
+  const std::vector<std::array<double, 3>>& xyz_weights() const { return xyz_weights_; }
 
   // Sky radiance (XYZ) at `position` (m, planet-centred) looking along `direction` (unit), with
   // the sun centre along `sun_direction` (unit). Adaptive to the target error.
@@ -96,6 +110,9 @@ class PathTracer {
   // atmosphere (0 if the ray hits the ground) for k wavelengths.
   void Transmittance(const glm::dvec3& position, const glm::dvec3& direction, const size_t* idx, int k, Pcg32& rng,
                      double* T) const;
+  // The same up to a distance t_max along the ray (unblocked by the ground before t_max).
+  void TransmittanceAlong(const glm::dvec3& position, const glm::dvec3& direction, double t_max, const size_t* idx,
+                          int k, Pcg32& rng, double* T) const;
 
   static constexpr int kMaxWavelengths = 16;
 
@@ -115,6 +132,9 @@ class PathTracer {
   void SunNee(const glm::dvec3& x, const glm::dvec3& d, bool ground, const double* beta, const size_t* idx, int k,
               const glm::dvec3& sun, Pcg32& rng, double* L) const;
   double MixturePhase(const AtmosphereModel::Cell& cell, size_t wl, double mu) const;
+  // Segment NEE (see PathTracerSettings::segment_nee) for the segment from p along d.
+  void SegmentSunNee(const glm::dvec3& p, const glm::dvec3& d, const double* beta, const size_t* idx, int k,
+                     const glm::dvec3& sun, Pcg32& rng, double* L) const;
 
   const AtmosphereModel& model_;
   std::vector<std::array<double, 3>> xyz_weights_;

@@ -1,0 +1,129 @@
+#include "transport/sky_render.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include <glm/geometric.hpp>
+
+namespace skybake {
+
+namespace {
+constexpr double kPi = std::numbers::pi;
+}
+
+double TransmittanceToSpace(const AtmosphereModel& m, double altitude_m, double zenith_rad, size_t wl) {
+  const double r0 = m.bottom_radius_m + altitude_m;
+  const double mu = std::cos(zenith_rad);
+  // Ray-sphere geometry from r0 along mu: r(t)^2 = r0^2 + 2 r0 mu t + t^2.
+  const double b = r0 * mu;
+  const double disc_ground = b * b - (r0 * r0 - m.bottom_radius_m * m.bottom_radius_m);
+  if (mu < 0.0 && disc_ground >= 0.0) {
+    const double t_ground = -b - std::sqrt(disc_ground);
+    if (t_ground >= 0.0) return 0.0;
+  }
+  const double length = -b + std::sqrt(std::max(0.0, b * b - (r0 * r0 - m.top_radius_m * m.top_radius_m)));
+  // Composite 4-point Gauss-Legendre on pieces of <= 100 m (the profile's level spacing is
+  // 100 m by default; the integrand is smooth within a level and the rule is exact to ~1e-7).
+  static const double kX[2] = {0.3399810435848563, 0.8611363115940526};
+  static const double kW[2] = {0.6521451548625461, 0.3478548451374538};
+  const int pieces = std::max(1, static_cast<int>(std::ceil(length / 100.0)));
+  const double h = length / pieces;
+  double tau = 0.0;
+  for (int p = 0; p < pieces; ++p) {
+    const double c = (p + 0.5) * h;
+    for (int k = 0; k < 2; ++k) {
+      for (double sgn : {-1.0, 1.0}) {
+        const double t = c + sgn * 0.5 * h * kX[k];
+        const double r = std::sqrt(r0 * r0 + 2.0 * r0 * mu * t + t * t);
+        tau += kW[k] * 0.5 * h * m.Extinction(m.Locate(r - m.bottom_radius_m), wl);
+      }
+    }
+  }
+  return std::exp(-tau);
+}
+
+SkyRenderResult RenderSky(const PathTracer& tracer, const SkyRenderSettings& s, const ProgressFn& progress) {
+  const AtmosphereModel& m = tracer.model();
+  const size_t nw = m.wavelengths();
+  SkyRenderResult result;
+  const glm::dvec3 observer(0.0, 0.0, m.bottom_radius_m + s.observer_altitude_m);
+  const DirectionGrid& g = s.directions;
+  const size_t texels = static_cast<size_t>(g.width) * static_cast<size_t>(g.height);
+
+  // Transmittance table.
+  for (int a = 0; a < s.transmittance_angles; ++a) {
+    const double zen = 180.0 * a / std::max(1, s.transmittance_angles - 1);
+    result.transmittance_zenith_deg.push_back(zen);
+    for (size_t w = 0; w < nw; ++w) {
+      result.transmittance.push_back(TransmittanceToSpace(m, s.observer_altitude_m, zen * kPi / 180.0, w));
+    }
+  }
+
+  // Texels to compute: one of each mirror pair.
+  std::vector<size_t> work;
+  std::vector<size_t> mirror(texels);
+  for (int y = 0; y < g.height; ++y) {
+    for (int x = 0; x < g.width; ++x) {
+      const size_t t = static_cast<size_t>(y) * g.width + x;
+      const size_t tm = g.mapping == DirectionMapping::kEquirectangular
+                            ? static_cast<size_t>(y) * g.width + (g.width - 1 - x)
+                            : static_cast<size_t>(g.height - 1 - y) * g.width + x;
+      mirror[t] = tm;
+      if (t <= tm) work.push_back(t);
+    }
+  }
+
+  const size_t total_tasks = work.size() * s.sun_zenith_deg.size();
+  std::atomic<size_t> done{0};
+  std::atomic<uint64_t> total_paths{0};
+  for (size_t si = 0; si < s.sun_zenith_deg.size(); ++si) {
+    SkySlice slice;
+    slice.sun_zenith_deg = s.sun_zenith_deg[si];
+    const double theta_s = slice.sun_zenith_deg * kPi / 180.0;
+    const glm::dvec3 sun = DirectionFromAngles(theta_s, 0.0);
+    slice.xyz.assign(texels * 3, std::numeric_limits<float>::quiet_NaN());
+    slice.y_stderr.assign(texels, std::numeric_limits<float>::quiet_NaN());
+    slice.paths.assign(texels, 0.0f);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, work.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
+      for (size_t k = range.begin(); k != range.end(); ++k) {
+        const size_t t = work[k];
+        const int x = static_cast<int>(t % static_cast<size_t>(g.width)), y = static_cast<int>(t / static_cast<size_t>(g.width));
+        std::optional<std::array<double, 3>> d = g.TexelDirection(x, y);
+        if (d) {
+          const glm::dvec3 dir = glm::normalize(glm::dvec3((*d)[0], (*d)[1], (*d)[2]));
+          const uint64_t stream = static_cast<uint64_t>(si) * texels + t;
+          ColorEstimate e = tracer.Radiance(observer, dir, sun, stream);
+          for (size_t tt : {t, mirror[t]}) {
+            for (size_t c = 0; c < 3; ++c) slice.xyz[tt * 3 + c] = static_cast<float>(e.xyz[c]);
+            slice.y_stderr[tt] = static_cast<float>(e.xyz_stderr[1]);
+            slice.paths[tt] = static_cast<float>(e.paths);
+          }
+          total_paths += e.paths;
+        }
+        const size_t n = ++done;
+        if (progress && (n % 64 == 0 || n == total_tasks)) progress("sky radiance", static_cast<double>(n) / total_tasks);
+      }
+    });
+    // Direct sun at the observer (disk centre transmittance).
+    slice.sun_irradiance.resize(nw);
+    for (size_t w = 0; w < nw; ++w) {
+      slice.sun_irradiance[w] = m.sun.irradiance[w] * TransmittanceToSpace(m, s.observer_altitude_m, theta_s, w);
+      for (size_t c = 0; c < 3; ++c) slice.sun_xyz[c] += tracer.xyz_weights()[w][c] * slice.sun_irradiance[w];
+    }
+    if (s.ambient) {
+      const uint64_t stream = (uint64_t{1} << 40) + si;
+      slice.ambient = tracer.Irradiance(observer, sun, stream);
+      total_paths += slice.ambient.paths;
+    }
+    result.slices.push_back(std::move(slice));
+  }
+  result.total_paths = total_paths;
+  return result;
+}
+
+}  // namespace skybake
