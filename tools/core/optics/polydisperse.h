@@ -1,0 +1,120 @@
+// Polydisperse Mie optics: integrals of single-sphere cross sections and scattering intensities
+// over the log-normal modes of a particle type, per wavelength, and the Mie table built from them.
+//
+// Per mode (number distribution n(u) du over u = ln r, normalised to one particle inside
+// [r_min, r_max]; particle_type.h), with k = 2 pi / lambda and x = k r:
+//   <C_ext> = int pi r^2 Q_ext(x, m) n(u) du       (same for sca, abs; g C_sca with g Q_sca)
+//   <dC_sca/dOmega>(theta) = int i(theta; x, m) / k^2 n(u) du,   i = (|S1|^2 + |S2|^2)/2
+// Modes combine by number fraction f_i (Wiscombe, MIEV.doc L345-371: integrate cross sections and
+// intensities, never Q, albedo, g or the normalised P; notes/mie-numerics.md §3.4):
+//   <C> = sum f_i <C>_i,  omega = <C_sca>/<C_ext>,  g = sum f_i <g C_sca>_i / <C_sca>,
+//   P(theta) = sum f_i <dC_sca/dOmega>_i / <C_sca>    (integral 1 over the sphere).
+//
+// Radius quadrature (docs/mie.md, "Radius quadrature"):
+//   - modes with the same refractive index share one radius grid: each node (one Mie
+//     evaluation) serves every such mode, weighted by sum_i f_i n_i(u);
+//   - a mode's domain: [ln r_min, ln r_max] intersected with [ln r_g - 8 s, ln r_g + 6 s^2 + 8 s].
+//     Outside it every power-law weight r^p n(r), 0 <= p <= 6 (Rayleigh scattering ~ r^6 through
+//     geometric optics ~ r^2) is below Phi(-8) = 6e-16 of its total, so nothing measurable is
+//     left out; the normalisation uses the full [r_min, r_max] (analytic, erf);
+//   - panels: the union of every mode's partition of its domain into pieces of width <= s/2;
+//     each panel lies wholly inside or outside each mode's domain, so a truncated mode is the
+//     exact composite trapezoid on its own domain. Panel p gets n_p = max(1, ceil(Delta x_p / 2))
+//     intervals at level 0 (Delta x_p its size-parameter span): the spacing adapts to the size
+//     parameter, at most 2 in x and s/2 in u;
+//   - each level halves every interval (nested: only the new midpoints are computed);
+//   - converged when, between two levels, the mixture's C_ext, C_sca, C_abs (relative to C_ext),
+//     g C_sca (relative to C_sca) and phase function (L1 distance int |P_L - P_{L-1}| dOmega)
+//     all change by less than `tolerance` (1e-4) relative, and the spacing is at most 0.5 in x
+//     (2 nodes per ripple period or more, so that under-sampled ripple cannot look converged).
+//     The criterion is on the integrals the table stores (the mixture's), not on each mode:
+//     a mode holding 5 % of the extinction needs only 2e-3 of its own.
+#pragma once
+
+#include <complex>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "io/progress.h"
+#include "optics/mie_angular.h"
+#include "optics/mie_table.h"
+#include "optics/particle_type.h"
+#include "optics/phase_grid.h"
+
+namespace skybake::mie {
+
+struct QuadratureOptions {
+  double tolerance = 1e-4;         // relative change between levels that counts as converged
+  double x_step_start = 2.0;       // level-0 spacing in size parameter, at most
+  double x_step_accept = 0.5;      // convergence is accepted only at this spacing or finer
+  double u_step_start_sigmas = 0.5;  // level-0 spacing in ln r, at most, in units of s
+  double window_sigmas = 8.0;      // the domain described above
+  int max_levels = 16;
+  int min_levels = 0;              // refine at least this many times (tests of convergence)
+};
+
+// The angle grid, its p_n/q_n tables, and a coarser grid (every 4th angle of [0, pi/2], and
+// pi/2) on which the phase function's convergence is checked between levels; the full grid is
+// evaluated once, at the converged level. The L1 distance on the coarse grid is a trapezoid
+// estimate of the same integral.
+struct PhaseTables {
+  PhaseGrid grid, check_grid;
+  AngularTables tables, check_tables;
+};
+PhaseTables MakePhaseTables(const PhaseGrid& grid, int max_terms, size_t check_stride = 4);
+
+// One component of a mixture: a mode, its number fraction in the mixture and its index at the
+// wavelength.
+struct MixturePart {
+  const LogNormalMode* mode = nullptr;
+  double fraction = 1.0;
+  std::complex<double> m;
+};
+
+struct MixtureIntegral {
+  // Per particle of the mixture (the fractions weight the parts).
+  double cext_m2 = 0.0, csca_m2 = 0.0, cabs_m2 = 0.0, gcsca_m2 = 0.0;
+  std::vector<double> dcsca_domega_m2_sr;  // per grid angle (empty without tables)
+  int radii = 0;        // Mie evaluations in all (nodes of the final level, every group)
+  std::vector<int> group_radii;  // per refractive-index group, in order of first appearance
+  std::vector<std::string> group_modes;  // the modes of each group, "+"-joined
+  int levels = 0;       // refinements after level 0
+  double change = 0.0;  // largest relative change at the last refinement
+  double phase_change = 0.0;  // its phase-function part (L1)
+  double x_min = 0.0, x_max = 0.0;  // size-parameter range integrated
+  bool converged = false;
+};
+
+// The mixture at one wavelength. `phase` may be null (no phase function then).
+MixtureIntegral IntegrateMixture(std::span<const MixturePart> parts, double wavelength_nm, const PhaseTables* phase,
+                                 const QuadratureOptions& options);
+// One mode alone (fraction 1).
+MixtureIntegral IntegrateMode(const LogNormalMode& mode, double wavelength_nm, std::complex<double> m,
+                              const PhaseTables* phase, const QuadratureOptions& options);
+
+// Largest size parameter a mode's quadrature reaches at a wavelength (for table sizing).
+double ModeMaxSizeParameter(const LogNormalMode& mode, double wavelength_nm, const QuadratureOptions& options);
+
+struct MieBuildOptions {
+  QuadratureOptions quadrature;
+  PhaseGrid grid = StandardPhaseGrid();
+  bool fits = true;
+};
+
+struct MieBuild {
+  MieTable table;
+  // Per wavelength: how the integral converged (phase arrays dropped), for the report.
+  std::vector<MixtureIntegral> integrals;
+};
+
+// The whole table: wavelengths in parallel (TBB), each computed independently and in a fixed
+// order, so the result does not depend on the number of threads. Throws InputError when a
+// wavelength is outside a mode's refractive-index table, and when a quadrature does not converge.
+MieBuild BuildMieTable(const ParticleType& type, std::span<const double> wavelengths_nm,
+                       const MieBuildOptions& options, const ProgressFn& progress = {});
+
+// Text describing the modes and their derived parameters (stored in the table and the report).
+std::string DescribeModes(const ParticleType& type);
+
+}  // namespace skybake::mie
