@@ -73,6 +73,12 @@ void AtmosphereModel::Finalize() {
   SKYBAKE_CHECK_EQ(ground_albedo.size(), nw);
   SKYBAKE_CHECK_EQ(sun.irradiance.size(), nw);
   SKYBAKE_CHECK(sun.limb_coefficients.empty() || sun.limb_coefficients.size() == nw);
+  // Uniform levels (profile-import's grid) are located by direct indexing.
+  uniform_step_ = altitude_m[1] - altitude_m[0];
+  for (size_t i = 1; i + 1 < nl; ++i) {
+    if (std::abs(altitude_m[i] - static_cast<double>(i) * uniform_step_) > 1e-9 * altitude_m.back()) uniform_step_ = 0.0;
+  }
+  if (uniform_step_ > 0.0 && altitude_m.back() - altitude_m[nl - 2] > uniform_step_ * (1 + 1e-12)) uniform_step_ = 0.0;
   extinction_.assign(nl * nw, 0.0);
   scattering_.assign(nl * nw, 0.0);
   for (const MediumComponent& c : components) {
@@ -91,6 +97,10 @@ AtmosphereModel::Cell AtmosphereModel::Locate(double z) const {
   const size_t nl = levels();
   if (z <= altitude_m.front()) return {0, 0.0};
   if (z >= altitude_m.back()) return {nl - 2, 1.0};
+  if (uniform_step_ > 0.0) {
+    const size_t i = std::min(static_cast<size_t>(z / uniform_step_), nl - 2);
+    return {i, std::clamp((z - altitude_m[i]) / (altitude_m[i + 1] - altitude_m[i]), 0.0, 1.0)};
+  }
   auto it = std::upper_bound(altitude_m.begin(), altitude_m.end(), z);
   size_t i = static_cast<size_t>(it - altitude_m.begin()) - 1;
   i = std::min(i, nl - 2);

@@ -124,6 +124,7 @@ class AtmosphereModel {
   double VerticalOpticalDepth(double a_m, double b_m, size_t wl) const;
 
  private:
+  double uniform_step_ = 0.0;        // > 0: levels at i * step (the last interval may be shorter)
   std::vector<double> extinction_;  // [level * n_wl + wl]
   std::vector<double> scattering_;  // [level * n_wl + wl]
 };

@@ -1,0 +1,110 @@
+"""CLI contract and behaviour of sky-render (runs the real binary, small renders)."""
+import os
+import struct
+import unittest
+
+from skytest import SRC, CliContract, TempDirTestCase, run, tool
+
+DATA = os.path.join(SRC, "atmospheres", "data")
+
+
+def rayleigh_atmosphere(tmp):
+    """The clear atmosphere without its aerosol layer (no Mie table needed), data by absolute path."""
+    with open(os.path.join(SRC, "atmospheres", "clear.yaml")) as f:
+        text = f.read()
+    text = text[:text.index("aerosols:")] + text[text.index("ground:"):]
+    text = text.replace("file: data/", "file: %s/" % DATA)
+    p = os.path.join(tmp, "rayleigh.yaml")
+    with open(p, "w") as f:
+        f.write(text)
+    return p
+
+
+class SkyRenderCli(CliContract, TempDirTestCase):
+    TOOL = "sky-render"
+
+    def render(self, *extra, out="sky.exr", size="8x4", wavelengths="400:700:20"):
+        atm = rayleigh_atmosphere(self.tmp)
+        args = [tool("sky-render"), "render", atm, "-o", self.path(out), "--size", size, "--sun-zenith-deg", "40",
+                "--target-error", "0.2", "--wavelengths", wavelengths, "--quiet"] + list(extra)
+        return run(args)
+
+    def test_real_run_is_read_back_by_a_second_program(self):
+        r = self.render("--preview", self.path("sky.png"), "--depfile", self.path("sky.exr.d"))
+        self.assertEqual(r.returncode, 0, r.stderr)
+        info = run(["oiiotool", "--info", "-v", "-a", self.path("sky.exr")])
+        self.assertEqual(info.returncode, 0, info.stderr)
+        for part in ("sky.sza_040.00", "transmittance", "sun", "irradiance"):
+            self.assertIn('name: "%s"' % part, info.stdout)
+        stats = run(["oiiotool", "--stats", self.path("sky.exr")])
+        self.assertEqual(stats.returncode, 0, stats.stderr)
+        png = run(["oiiotool", "--info", self.path("sky.png")])
+        self.assertIn("8 x    4", png.stdout)
+        with open(self.path("sky.exr.d")) as f:
+            dep = f.read()
+        for needle in ("astm_g173_03_solar_spectrum.csv", "cie2006_2deg_xyz_cmf_1nm.csv", "config.ocio"):
+            self.assertIn(needle, dep)
+
+    def test_same_bytes_at_any_thread_count(self):
+        self.assertEqual(self.render("--threads", "1", out="a.exr").returncode, 0)
+        self.assertEqual(self.render("--threads", "2", out="b.exr").returncode, 0)
+        with open(self.path("a.exr"), "rb") as a, open(self.path("b.exr"), "rb") as b:
+            self.assertEqual(a.read(), b.read())
+
+    def test_bad_usage(self):
+        r = self.render(size="8by4")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("sky-render: --size: expected WxH (2 to 8192), got '8by4'", r.stderr)
+        r = self.render("--method", "magic")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("sky-render: --method: expected path, got 'magic'", r.stderr)
+        r = self.render(wavelengths="400:700")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("sky-render: --wavelengths: expected min:max:step in nm, got '400:700'", r.stderr)
+        self.assertFalse(os.path.exists(self.path("sky.exr")))
+
+    def test_bad_atmosphere_is_located(self):
+        bad = self.write("bad.yaml", "planet: {radius_km: 6371, top_km: 100}\nair: {profile: ussa1976}\n"
+                                     "sun: {angular_diameter_deg: 0.5}\n")
+        r = run([tool("sky-render"), "render", bad, "-o", self.path("x.exr"), "--quiet"])
+        self.assertEqual(r.returncode, 1)
+        self.assertEqual(r.stderr, "sky-render: %s:3: missing key 'sun.spectrum': expected a mapping\n" % bad)
+        self.assertFalse(os.path.exists(self.path("x.exr")))
+
+    def test_aerosol_layer_without_mie_dir_is_a_usage_error(self):
+        atm = rayleigh_atmosphere(self.tmp)
+        with open(atm, "a") as f:
+            f.write("aerosols:\n  - name: haze\n    particle: %s\n    profile: {exponential: {scale_height_km: 1.2}}\n"
+                    "    scale: {optical_depth_550nm: 0.1}\n" % os.path.join(SRC, "particles", "continental.yaml"))
+        r = run([tool("sky-render"), "render", atm, "-o", self.path("x.exr"), "--quiet"])
+        self.assertEqual(r.returncode, 2, r.stderr)
+        self.assertIn("sky-render: aerosol layer 'haze' needs its Mie table: pass --mie-dir (the folder of continental.exr, "
+                      "written by mie-tables)", r.stderr)
+
+    def test_points_csv(self):
+        atm = rayleigh_atmosphere(self.tmp)
+        geom = self.write("g.csv", "# source: test geometries\nsun_zenith_deg,view_zenith_deg,relative_azimuth_deg\n"
+                                   "30,0,0\n30,60,180\n")
+        r = run([tool("sky-render"), "points", atm, "--geometry", geom, "-o", self.path("out.csv"),
+                 "--wavelengths", "400:700:20", "--wavelengths-out", "440,560", "--paths", "2000", "--target-error", "0.2"])
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(self.path("out.csv")) as f:
+            lines = [l for l in f.read().splitlines() if not l.startswith("#")]
+        self.assertEqual(len(lines), 3)
+        header = lines[0].split(",")
+        self.assertIn("radiance_440nm_W_m2_sr_nm", header)
+        row = dict(zip(header, lines[1].split(",")))
+        # Zenith sky at 440 nm is bluer (brighter per nm) than at 560 nm (Rayleigh ~ lambda^-4).
+        self.assertGreater(float(row["radiance_440nm_W_m2_sr_nm"]), float(row["radiance_560nm_W_m2_sr_nm"]))
+
+    def test_points_bad_geometry_row(self):
+        atm = rayleigh_atmosphere(self.tmp)
+        geom = self.write("g.csv", "# source: test\nsun_zenith_deg,view_zenith_deg,relative_azimuth_deg\n30,0,0\n30,x,0\n")
+        r = run([tool("sky-render"), "points", atm, "--geometry", geom, "-o", self.path("out.csv"), "--wavelengths", "400:700:20",
+                 "--quiet"])
+        self.assertEqual(r.returncode, 1)
+        self.assertEqual(r.stderr, "sky-render: %s:4: column 'view_zenith_deg': expected a number, got \"x\"\n" % geom)
+
+
+if __name__ == "__main__":
+    unittest.main()

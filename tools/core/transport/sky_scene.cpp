@@ -1,0 +1,329 @@
+#include "transport/sky_scene.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
+
+#include "atmosphere/mie_optics.h"
+#include "atmosphere/model_build.h"
+#include "color/color.h"
+#include "color/exr_color.h"
+#include "io/csv.h"
+#include "io/exr.h"
+#include "io/fileio.h"
+#include "io/png.h"
+#include "io/yaml.h"
+#include "lut/directions.h"
+#include "optics/mie_table.h"
+
+namespace fs = std::filesystem;
+
+namespace skybake {
+
+namespace {
+
+std::optional<double> ParseNumber(const std::string& s) {
+  double v = 0.0;
+  auto r = std::from_chars(s.data(), s.data() + s.size(), v);
+  if (r.ec != std::errc() || r.ptr != s.data() + s.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+AerosolPhase ParseAerosolPhase(const std::string& s) {
+  for (AerosolPhase p : {AerosolPhase::kTabulated, AerosolPhase::kHenyeyGreenstein, AerosolPhase::kHenyeyGreensteinMoment,
+                         AerosolPhase::kCornetteShanks, AerosolPhase::kDualLobe}) {
+    if (s == AerosolPhaseName(p)) return p;
+  }
+  throw UsageError("--aerosol-phase: expected mie, hg, hg-moment, cornette-shanks or dual-lobe, got '" + s + "'");
+}
+
+std::string SliceName(double sza) { return fmt::format("sky.sza_{:06.2f}", sza); }
+
+}  // namespace
+
+WavelengthGrid ParseWavelengthGrid(const std::string& text) {
+  std::vector<double> parts;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ':')) {
+    std::optional<double> v = ParseNumber(item);
+    if (!v) throw UsageError("--wavelengths: expected min:max:step in nm, got '" + text + "'");
+    parts.push_back(*v);
+  }
+  if (parts.size() != 3) throw UsageError("--wavelengths: expected min:max:step in nm, got '" + text + "'");
+  try {
+    return WavelengthGrid::Uniform(parts[0], parts[1], parts[2]);
+  } catch (const InputError& e) {
+    throw UsageError("--wavelengths: " + std::string(e.what()));
+  }
+}
+
+Scene LoadScene(const SceneOptions& o, const ProgressFn& progress) {
+  Scene s;
+  s.grid = ParseWavelengthGrid(o.wavelengths);
+  std::optional<Observer> obs = ParseObserver(o.observer);
+  if (!obs) throw UsageError("--observer: expected cie2006_2deg or cie1931_2deg, got '" + o.observer + "'");
+  s.observer = *obs;
+  const AerosolPhase phase = ParseAerosolPhase(o.aerosol_phase);
+  if (o.illumination != "sun" && o.illumination != "uniform") {
+    throw UsageError("--illumination: expected sun or uniform, got '" + o.illumination + "'");
+  }
+
+  ReportProgress(progress, "loading", 0.0);
+  s.spec = LoadAtmosphere(o.atmosphere);
+  s.files_read.push_back(o.atmosphere);
+  if (o.profiles.empty()) {
+    if (!s.spec.grid) s.spec.grid = GridSpec{100.0};
+    s.profiles = ComputeProfiles(s.spec);
+    s.files_read.insert(s.files_read.end(), s.profiles.inputs_read.begin(), s.profiles.inputs_read.end());
+  } else {
+    s.profiles = ProfilesFromTable(ImageToTable(ReadExr(o.profiles), o.profiles), o.profiles);
+    s.files_read.push_back(o.profiles);
+  }
+
+  // Aerosol optics from the Mie tables: <mie_dir>/<particle file stem>.exr.
+  std::vector<AerosolOptics> aerosols;
+  for (const AerosolLayerSpec& layer : s.spec.aerosols) {
+    if (!layer.particle) {
+      throw InputError(FileLoc{s.spec.file.string(), 0}, "aerosol layer '" + layer.name + "' has no 'particle' type");
+    }
+    if (o.mie_dir.empty()) {
+      throw UsageError("aerosol layer '" + layer.name + "' needs its Mie table: pass --mie-dir (the folder of " +
+                       layer.particle->stem().string() + ".exr, written by mie-tables)");
+    }
+    const fs::path table_path = fs::path(o.mie_dir) / (layer.particle->stem().string() + ".exr");
+    auto table = std::make_shared<mie::MieTable>(mie::ReadMieTable(table_path));
+    s.files_read.push_back(table_path);
+    aerosols.push_back(AerosolOpticsFromMie(layer.name, table, s.grid, phase));
+  }
+
+  ModelOptions mo;
+  mo.ozone = !o.no_ozone;
+  s.model = BuildAtmosphereModel(s.spec, s.profiles, s.grid, aerosols, mo, &s.files_read);
+
+  // Colour weights.
+  const Cmf cmf = Cmf::LoadDefault(s.observer);
+  s.files_read.push_back(cmf.path());
+  s.xyz = std::make_shared<XyzWeights>(s.grid, cmf);
+  for (size_t i = 0; i < s.grid.size(); ++i) s.xyz_weights.push_back({s.xyz->wx()[i], s.xyz->wy()[i], s.xyz->wz()[i]});
+  s.ocio_config = ColorConfig::ResolvePath(o.ocio_config);
+  s.files_read.push_back(s.ocio_config);
+
+  s.tracer.illumination = o.illumination == "uniform" ? Illumination::kUniform : Illumination::kSun;
+  s.tracer.target_relative_error = o.target_error;
+  s.tracer.min_paths = o.min_paths;
+  s.tracer.max_paths = std::max(o.max_paths, o.min_paths);
+  s.tracer.seed = o.seed;
+  s.tracer.max_order = o.max_order;
+
+  YAML::Emitter y;
+  y << YAML::BeginMap;
+  y << YAML::Key << "wavelengths" << YAML::Value << s.grid.Describe();
+  y << YAML::Key << "observer" << YAML::Value << ObserverName(s.observer);
+  y << YAML::Key << "aerosol_phase" << YAML::Value << AerosolPhaseName(phase);
+  y << YAML::Key << "ozone" << YAML::Value << (o.no_ozone ? "off" : "on");
+  y << YAML::Key << "illumination" << YAML::Value << o.illumination;
+  y << YAML::Key << "target_relative_error" << YAML::Value << FormatExact(o.target_error);
+  y << YAML::Key << "min_paths" << YAML::Value << o.min_paths;
+  y << YAML::Key << "max_paths" << YAML::Value << s.tracer.max_paths;
+  y << YAML::Key << "seed" << YAML::Value << o.seed;
+  y << YAML::Key << "max_order" << YAML::Value << o.max_order;
+  y << YAML::EndMap;
+  s.parameters = std::string(y.c_str()) + "\n" + CanonicalRenderYaml(s.spec, fs::path(o.atmosphere).parent_path());
+  return s;
+}
+
+RenderProducts RenderProductsOf(const Scene& scene, const RenderOptions& o, const ProgressFn& progress) {
+  if (o.method != "path") throw UsageError("--method: expected path, got '" + o.method + "'");
+  RenderProducts p;
+  std::optional<DirectionMapping> mapping = ParseDirectionMapping(o.mapping);
+  if (!mapping) throw UsageError("--mapping: expected equirectangular or fisheye, got '" + o.mapping + "'");
+  int w = 0, h = 0;
+  if (std::sscanf(o.size.c_str(), "%dx%d", &w, &h) != 2 || w < 2 || h < 2 || w > 8192 || h > 8192) {
+    throw UsageError("--size: expected WxH (2 to 8192), got '" + o.size + "'");
+  }
+  p.settings.directions = DirectionGrid{*mapping, w, h};
+  for (double z : o.sun_zenith_deg) {
+    if (!(z >= 0.0 && z <= 180.0)) throw UsageError(fmt::format("--sun-zenith-deg: {} is outside 0-180", z));
+  }
+  p.settings.sun_zenith_deg = o.sun_zenith_deg;
+  p.settings.observer_altitude_m = o.observer_altitude_m >= 0.0 ? o.observer_altitude_m : scene.spec.observer_altitude_m;
+  if (p.settings.observer_altitude_m >= scene.model.altitude_m.back()) {
+    throw UsageError("the observer must be inside the atmosphere");
+  }
+  PathTracer tracer(scene.model, scene.xyz_weights, scene.tracer);
+  p.sky = RenderSky(tracer, p.settings, progress);
+  return p;
+}
+
+void WriteRender(const Scene& scene, const RenderOptions& o, const RenderProducts& p, const fs::path& path,
+                 const std::string& tool) {
+  Provenance prov;
+  prov.tool = tool;
+  prov.parameters = fmt::format("method: {}\nmapping: {}\nsize: {}\n", o.method, o.mapping, o.size) + scene.parameters;
+  for (const fs::path& f : scene.files_read) prov.AddInput(f);
+
+  ColorConfig config = ColorConfig::Load(scene.ocio_config);
+  ColorProcessor to_reference = config.Converter(XyzColorSpace(scene.observer), ocio_names::kCieXyzD65);
+  const DirectionGrid& g = p.settings.directions;
+  const size_t nw = scene.grid.size();
+  std::vector<ExrPart> parts;
+  for (const SkySlice& sl : p.sky.slices) {
+    std::vector<float> rgb = sl.xyz;
+    to_reference.Apply(rgb);
+    ExrImage img = MakeColorImage(g.width, g.height, rgb, ocio_names::kCieXyzD65);
+    // Extra channels beside R, G, B.
+    ExrImage full;
+    full.Resize(g.width, g.height, {"R", "G", "B", "Y_stderr", "paths"});
+    for (size_t t = 0; t < static_cast<size_t>(g.width) * g.height; ++t) {
+      for (size_t c = 0; c < 3; ++c) full.pixels[t * 5 + c] = rgb[t * 3 + c];
+      full.pixels[t * 5 + 3] = sl.y_stderr[t];
+      full.pixels[t * 5 + 4] = sl.paths[t];
+    }
+    full.chromaticities = img.chromaticities;
+    full.strings = img.strings;
+    full.strings["skybake.quantity"] = "sky radiance without the sun disk; R, G, B = X, Y, Z (cd/m^2)";
+    full.strings["skybake.observer"] = ObserverName(scene.observer);
+    full.strings["skybake.mapping"] = g.Describe();
+    full.doubles["skybake.sun_zenith_deg"] = sl.sun_zenith_deg;
+    full.doubles["skybake.observer_altitude_m"] = p.settings.observer_altitude_m;
+    SetProvenance(full, prov);
+    parts.push_back({SliceName(sl.sun_zenith_deg), std::move(full)});
+  }
+  // Transmittance table (wavelength x view zenith).
+  {
+    ExrTable t;
+    t.axes.push_back({"wavelength", "nm", scene.grid.Describe(), scene.grid.wavelength_nm()});
+    t.axes.push_back({"view_zenith", "deg", "view zenith angle from the observer", p.sky.transmittance_zenith_deg});
+    t.channels = {"transmittance"};
+    t.channel_units = {"1"};
+    for (double v : p.sky.transmittance) t.values.push_back(static_cast<float>(v));
+    ExrImage img = TableToImage(t);
+    img.strings["skybake.quantity"] = "transmittance from the observer to the top of the atmosphere (0 into the ground)";
+    SetProvenance(img, prov);
+    parts.push_back({"transmittance", std::move(img)});
+  }
+  // Direct sun (spectral) and irradiances (colour) per sun angle.
+  {
+    ExrTable t;
+    t.axes.push_back({"wavelength", "nm", scene.grid.Describe(), scene.grid.wavelength_nm()});
+    t.axes.push_back({"sun_zenith", "deg", "sun zenith angle", p.settings.sun_zenith_deg});
+    t.channels = {"irradiance"};
+    t.channel_units = {"W m^-2 nm^-1"};
+    for (const SkySlice& sl : p.sky.slices) {
+      for (size_t w = 0; w < nw; ++w) t.values.push_back(static_cast<float>(sl.sun_irradiance[w]));
+    }
+    ExrImage img = TableToImage(t);
+    img.strings["skybake.quantity"] = "direct sun spectral irradiance at the observer, normal incidence (disk-centre transmittance)";
+    SetProvenance(img, prov);
+    parts.push_back({"sun", std::move(img)});
+  }
+  {
+    ExrTable t;
+    t.axes.push_back({"sun_zenith", "deg", "sun zenith angle", p.settings.sun_zenith_deg});
+    t.channels = {"sun_X", "sun_Y", "sun_Z", "sun_horizontal_Y", "ambient_X", "ambient_Y", "ambient_Z", "ambient_Y_stderr"};
+    t.channel_units = {"lx", "lx", "lx", "lx", "lx", "lx", "lx", "lx"};
+    for (const SkySlice& sl : p.sky.slices) {
+      std::vector<float> sun = {static_cast<float>(sl.sun_xyz[0]), static_cast<float>(sl.sun_xyz[1]),
+                                static_cast<float>(sl.sun_xyz[2])};
+      std::vector<float> amb = {static_cast<float>(sl.ambient.xyz[0]), static_cast<float>(sl.ambient.xyz[1]),
+                                static_cast<float>(sl.ambient.xyz[2])};
+      to_reference.Apply(sun);
+      to_reference.Apply(amb);
+      const double mu_s = std::cos(sl.sun_zenith_deg * 3.14159265358979323846 / 180.0);
+      std::vector<float> row = {sun[0], sun[1], sun[2], static_cast<float>(sun[1] * std::max(0.0, mu_s)),
+                                amb[0], amb[1], amb[2], static_cast<float>(sl.ambient.xyz_stderr[1])};
+      t.values.insert(t.values.end(), row.begin(), row.end());
+    }
+    ExrImage img = TableToImage(t);
+    img.strings["skybake.quantity"] =
+        "illuminance (X, Y, Z in the CIE-XYZ-D65 reference): direct sun on a surface normal to it and on a horizontal "
+        "surface; sky (ambient) on a horizontal surface, without the sun disk";
+    SetProvenance(img, prov);
+    parts.push_back({"irradiance", std::move(img)});
+  }
+  WriteExrParts(path, parts);
+}
+
+void WriteRenderPreview(const Scene& scene, const RenderOptions& o, const RenderProducts& p, const fs::path& path) {
+  ColorConfig config = ColorConfig::Load(scene.ocio_config);
+  const DirectionGrid& g = p.settings.directions;
+  const size_t texels = static_cast<size_t>(g.width) * g.height;
+  std::vector<uint8_t> montage;
+  ColorProcessor to_reference = config.Converter(XyzColorSpace(scene.observer), ocio_names::kCieXyzD65);
+  for (const SkySlice& sl : p.sky.slices) {
+    std::vector<float> rgb = sl.xyz;
+    for (float& v : rgb) {
+      if (!std::isfinite(v)) v = 0.0f;  // outside the mapping: black
+    }
+    to_reference.Apply(rgb);
+    DisplayView view;
+    view.display = o.display;
+    view.exposure_stops = o.exposure_stops;
+    if (o.white == "auto") {
+      // The 99th percentile of Y shown as white, row by row (the sky spans 1e-3 to 1e4 cd/m^2).
+      std::vector<float> y;
+      for (size_t t = 0; t < texels; ++t) y.push_back(rgb[t * 3 + 1]);
+      std::sort(y.begin(), y.end());
+      view.white_cd_m2 = std::max(1e-9, static_cast<double>(y[std::min(y.size() - 1, y.size() * 99 / 100)]));
+    } else {
+      std::optional<double> w = ParseNumber(o.white);
+      if (!w || *w <= 0.0) throw UsageError("--white-cd-m2: expected a positive number or 'auto', got '" + o.white + "'");
+      view.white_cd_m2 = *w;
+    }
+    ColorProcessor display = config.Display(ocio_names::kCieXyzD65, view);
+    std::vector<uint8_t> row = EncodePreview8(g.width, g.height, rgb, display);
+    montage.insert(montage.end(), row.begin(), row.end());
+  }
+  WritePng8(path, g.width, g.height * static_cast<int>(p.sky.slices.size()), 3, montage);
+}
+
+void WritePoints(const Scene& scene, const PointsOptions& o, const fs::path& path) {
+  CsvTable csv = CsvTable::Load(o.geometry);
+  Diagnostics d;
+  std::vector<double> sza = csv.Numbers("sun_zenith_deg", d);
+  std::vector<double> vza = csv.Numbers("view_zenith_deg", d);
+  std::vector<double> raz = csv.Numbers("relative_azimuth_deg", d);
+  for (size_t r = 0; r < csv.rows() && d.empty(); ++r) {
+    if (sza[r] < 0 || sza[r] > 180) d.Add(csv.LocOfRow(r), "sun_zenith_deg must be in 0-180");
+    if (vza[r] < 0 || vza[r] > 180) d.Add(csv.LocOfRow(r), "view_zenith_deg must be in 0-180");
+  }
+  d.ThrowIfAny();
+  std::vector<size_t> idx;
+  for (double w : o.wavelengths_nm) {
+    auto it = std::find_if(scene.grid.wavelength_nm().begin(), scene.grid.wavelength_nm().end(),
+                           [&](double g) { return std::abs(g - w) < 1e-9; });
+    if (it == scene.grid.wavelength_nm().end()) throw UsageError(fmt::format("--wavelengths-out: {} nm is not on the grid", w));
+    idx.push_back(static_cast<size_t>(it - scene.grid.wavelength_nm().begin()));
+  }
+  PathTracer tracer(scene.model, scene.xyz_weights, scene.tracer);
+  const glm::dvec3 observer(0, 0, scene.model.bottom_radius_m + scene.spec.observer_altitude_m);
+  std::string out = "# source: sky-render points (path tracer, " + std::to_string(o.paths) +
+                    " paths per row); relative_azimuth_deg = 0 looks towards the sun's azimuth; L/E0 = radiance per unit "
+                    "extraterrestrial irradiance on a surface normal to the sun (sr^-1)\n";
+  out += "sun_zenith_deg,view_zenith_deg,relative_azimuth_deg";
+  for (double w : o.wavelengths_nm) {
+    out += fmt::format(",radiance_{0}nm_W_m2_sr_nm,stderr_{0}nm_W_m2_sr_nm,radiance_over_e0_{0}nm_per_sr", w);
+  }
+  out += ",Y_cd_m2,Y_stderr_cd_m2\n";
+  const double deg = 3.14159265358979323846 / 180.0;
+  for (size_t r = 0; r < csv.rows(); ++r) {
+    const glm::dvec3 sun = DirectionFromAngles(sza[r] * deg, 0.0);
+    const glm::dvec3 view = DirectionFromAngles(vza[r] * deg, raz[r] * deg);
+    std::vector<double> mean, se;
+    tracer.SpectralRadiance(observer, view, sun, idx, o.paths, r, &mean, &se);
+    ColorEstimate c = tracer.Radiance(observer, view, sun, (uint64_t{1} << 32) + r);
+    out += fmt::format("{},{},{}", FormatExact(sza[r]), FormatExact(vza[r]), FormatExact(raz[r]));
+    for (size_t j = 0; j < idx.size(); ++j) {
+      out += fmt::format(",{:.6e},{:.3e},{:.6e}", mean[j], se[j], mean[j] / scene.model.sun.irradiance[idx[j]]);
+    }
+    out += fmt::format(",{:.6e},{:.3e}\n", c.xyz[1], c.xyz_stderr[1]);
+  }
+  WriteFileIfChanged(path, out);
+}
+
+}  // namespace skybake

@@ -1,0 +1,105 @@
+// sky-render: sky radiance, transmittance, direct sun and ambient irradiance of an atmosphere
+// (docs/sky-render.md).
+//
+//   sky-render render ATMOSPHERE.yaml -o sky.exr [--profiles profiles.exr] [--mie-dir outputs/mie]
+//              [--method path] [--mapping equirectangular|fisheye] [--size 64x32]
+//              [--sun-zenith-deg 30,70,85,90,94] [--target-error 0.01] [--preview sky.png] ...
+//   sky-render points ATMOSPHERE.yaml --geometry in.csv -o out.csv [--wavelengths-out 440,550,680]
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "atmosphere/mie_optics.h"
+#include "atmosphere/model_build.h"
+#include "atmosphere/spec.h"
+#include "atmosphere/vertical_profiles.h"
+#include "color/color.h"
+#include "color/exr_color.h"
+#include "io/cli.h"
+#include "io/csv.h"
+#include "io/exr.h"
+#include "io/fileio.h"
+#include "io/repo_paths.h"
+#include "lut/directions.h"
+#include "spectrum/cmf.h"
+#include "spectrum/xyz.h"
+#include "transport/path_tracer.h"
+#include "transport/sky_render.h"
+#include "transport/sky_scene.h"
+
+namespace fs = std::filesystem;
+using namespace skybake;
+
+int main(int argc, char** argv) {
+  ToolCli cli("sky-render",
+              "Renders the sky of an atmosphere: spectral Monte-Carlo path tracing (the reference), output as\n"
+              "absolute XYZ radiance on a direction grid for a list of sun zenith angles, with transmittance,\n"
+              "direct sun and ambient irradiance. See docs/sky-render.md.");
+  cli.app().require_subcommand(1);
+  cli.app().fallthrough();
+  SceneOptions scene;
+  std::string output, depfile;
+
+  auto add_scene_options = [&](CLI::App* sub) {
+    sub->add_option("atmosphere", scene.atmosphere, "Atmosphere YAML (full, or its render component)")->required();
+    sub->add_option("--profiles", scene.profiles, "profiles.exr from profile-import (default: computed from the atmosphere)");
+    sub->add_option("--mie-dir", scene.mie_dir, "Folder with the Mie tables <particle>.exr of the aerosol layers");
+    sub->add_option("--wavelengths", scene.wavelengths, "Spectral grid min:max:step in nm")->default_val("360:830:5");
+    sub->add_option("--observer", scene.observer, "Colour-matching functions: cie2006_2deg or cie1931_2deg")
+        ->default_val("cie2006_2deg");
+    sub->add_option("--aerosol-phase", scene.aerosol_phase, "Aerosol phase model: mie, hg, hg-moment, cornette-shanks, dual-lobe")
+        ->default_val("mie");
+    sub->add_flag("--no-ozone", scene.no_ozone, "Drop ozone absorption (a simplification to measure)");
+    sub->add_option("--illumination", scene.illumination, "sun, or uniform (unit radiance from space: the white furnace)")
+        ->default_val("sun");
+    sub->add_option("--target-error", scene.target_error, "Target relative standard error of Y per estimate")
+        ->default_val(0.01)->check(CLI::Range(1e-4, 1.0));
+    sub->add_option("--min-paths", scene.min_paths, "Paths per estimate at least")->default_val(64);
+    sub->add_option("--max-paths", scene.max_paths, "Paths per estimate at most")->default_val(1u << 20);
+    sub->add_option("--seed", scene.seed, "Random seed")->default_val(1);
+    sub->add_option("--max-order", scene.max_order, "Highest scattering order (0 = all)")->default_val(0);
+    sub->add_option("--ocio-config", scene.ocio_config, "OCIO config (default: $SKYBAKE_OCIO or the repo's ocio/config.ocio)");
+    sub->add_option("-o,--output", output, "Output file")->required();
+    sub->add_option("--depfile", depfile, "Write a Make-style depfile of every file read");
+  };
+
+  CLI::App* render = cli.app().add_subcommand("render", "Sky images (EXR, multi-part) for a list of sun zenith angles");
+  add_scene_options(render);
+  RenderOptions ro;
+  render->add_option("--method", ro.method, "Rendering method: path")->default_val("path");
+  render->add_option("--mapping", ro.mapping, "Direction mapping: equirectangular or fisheye")->default_val("equirectangular");
+  render->add_option("--size", ro.size, "Image size WxH")->default_val("64x32");
+  render->add_option("--sun-zenith-deg", ro.sun_zenith_deg, "Sun zenith angles (deg), comma separated")
+      ->delimiter(',')->default_str("30,70,85,90,94");
+  render->add_option("--observer-altitude-m", ro.observer_altitude_m, "Override the atmosphere's observer altitude (m)");
+  render->add_option("--preview", ro.preview, "Also write a PNG preview (one row per sun angle, through the OCIO view)");
+  render->add_option("--display", ro.display, "Preview display: sRGB, Rec.1886 Rec.709 or Rec.2100-PQ")->default_val("sRGB");
+  render->add_option("--white-cd-m2", ro.white, "Preview: luminance shown as white, or 'auto' per row")->default_val("auto");
+  render->add_option("--exposure", ro.exposure_stops, "Preview exposure in stops")->default_val(0.0);
+
+  CLI::App* points = cli.app().add_subcommand("points", "Spectral radiance for explicit geometries (CSV in, CSV out)");
+  add_scene_options(points);
+  PointsOptions po;
+  points->add_option("--geometry", po.geometry, "CSV: sun_zenith_deg, view_zenith_deg, relative_azimuth_deg")->required();
+  points->add_option("--wavelengths-out", po.wavelengths_nm, "Output wavelengths (nm, on the grid)")->delimiter(',')->default_str("440,550,680");
+  points->add_option("--paths", po.paths, "Paths per geometry")->default_val(100000);
+
+  return cli.Run(argc, argv, [&] {
+    if (ro.sun_zenith_deg.empty()) ro.sun_zenith_deg = {30, 70, 85, 90, 94};
+    if (po.wavelengths_nm.empty()) po.wavelengths_nm = {440, 550, 680};
+    // Load and validate (every input file is recorded for the depfile).
+    Scene s = LoadScene(scene, cli.Progress());
+    if (render->parsed()) {
+      RenderProducts p = RenderProductsOf(s, ro, cli.Progress());
+      WriteRender(s, ro, p, output, cli.name());
+      if (!ro.preview.empty()) WriteRenderPreview(s, ro, p, ro.preview);
+      cli.Info(fmt::format("{} sun angles, {} paths", ro.sun_zenith_deg.size(), p.sky.total_paths));
+    } else {
+      WritePoints(s, po, output);
+    }
+    if (!depfile.empty()) WriteDepfile(depfile, output, s.files_read);
+  });
+}
