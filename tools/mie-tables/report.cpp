@@ -63,9 +63,9 @@ std::string BuildReportJson(const mie::ParticleType& type, const mie::MieBuild& 
   s += fmt::format("  \"wavelengths_nm\": {{\"count\": {}, \"min\": {}, \"max\": {}}},\n", t.wavelengths(),
                    Num(t.wavelength_nm.front()), Num(t.wavelength_nm.back()));
   s += fmt::format("  \"angles\": {},\n", t.theta_rad.size());
-  s += fmt::format("  \"quadrature\": {{\"tolerance\": {}, \"x_step_accept\": {}, \"window_sigmas\": {}}},\n",
+  s += fmt::format("  \"quadrature\": {{\"tolerance\": {}, \"x_step_accept\": {}, \"window_tail\": {}}},\n",
                    Num(options.quadrature.tolerance), Num(options.quadrature.x_step_accept),
-                   Num(options.quadrature.window_sigmas));
+                   Num(options.quadrature.window_tail));
   s += "  \"mean_particle_volume_m3\": " + Num(t.mean_particle_volume_m3) + ",\n";
   s += "  \"modes\": [";
   for (size_t i = 0; i < type.modes.size(); ++i) {

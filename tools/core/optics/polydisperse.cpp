@@ -44,12 +44,37 @@ struct Domain {
   double u_lo, u_hi;
 };
 
-Domain QuadratureDomain(const LogNormalMode& mode, const QuadratureOptions& o) {
+// Upper tail mass beyond h of N(c, s) (erfc, accurate far out).
+double TailAbove(double h, double c, double s) { return 0.5 * std::erfc((h - c) / (s * std::numbers::sqrt2)); }
+
+// Smallest h in [a, b] with the mass of N(c, s) above h at most eps times its mass inside [a, b]
+// (bisection; b if no smaller h qualifies). LowerTrim mirrors it.
+double UpperTrim(double a, double b, double c, double s, double eps) {
+  const double inside = TailAbove(a, c, s) - TailAbove(b, c, s);
+  auto excess = [&](double h) { return TailAbove(h, c, s) - TailAbove(b, c, s) - eps * inside; };
+  if (excess(a) <= 0.0) return a;
+  double lo = a, hi = b;
+  for (int i = 0; i < 100 && hi - lo > 1e-12 * std::max(1.0, std::abs(hi)); ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (excess(mid) > 0.0 ? lo : hi) = mid;
+  }
+  return hi;
+}
+double LowerTrim(double a, double b, double c, double s, double eps) { return -UpperTrim(-b, -a, -c, s, eps); }
+
+Domain QuadratureDomain(const LogNormalMode& mode, double k, const QuadratureOptions& o) {
   const double s = mode.LnSigma();
   const double mu = std::log(mode.NumberMedianRadiusUm() * 1e-6);
-  const double lo = std::max(std::log(mode.r_min_um * 1e-6), mu - o.window_sigmas * s);
-  const double hi = std::min(std::log(mode.r_max_um * 1e-6), mu + 6.0 * s * s + o.window_sigmas * s);
-  return {lo, hi};
+  const double a = std::log(mode.r_min_um * 1e-6), b = std::log(mode.r_max_um * 1e-6);
+  const double eps = o.window_tail;
+  // Geometric optics (C ~ r^2): the area-weighted log-normal, centred at mu + 2 s^2.
+  const double lo = LowerTrim(a, b, mu + 2.0 * s * s, s, eps);
+  double hi = UpperTrim(a, b, mu + 2.0 * s * s, s, eps);
+  // Rayleigh scattering (C ~ r^6), centred at mu + 6 s^2, matters only while x < 5.
+  const double hi_rayleigh = std::min(UpperTrim(a, b, mu + 6.0 * s * s, s, eps), std::log(5.0 / k));
+  hi = std::max(hi, hi_rayleigh);
+  if (!(hi > lo)) return {a, b};  // (cannot happen for a valid mode; keep the whole range then)
+  return {lo, std::min(hi, b)};
 }
 
 // The modes sharing one refractive index, on one radius grid.
@@ -63,7 +88,7 @@ class Group {
     part.s = mode.LnSigma();
     part.mu = std::log(mode.NumberMedianRadiusUm() * 1e-6);
     part.scale = p.fraction / (std::sqrt(2.0 * kPi) * part.s * mode.NumberFractionInside());
-    const Domain d = QuadratureDomain(mode, o_);
+    const Domain d = QuadratureDomain(mode, k_, o_);
     SKYBAKE_CHECK_LT(d.u_lo, d.u_hi);
     part.lo = d.u_lo;
     part.hi = d.u_hi;
@@ -168,7 +193,8 @@ class Group {
 }  // namespace
 
 double ModeMaxSizeParameter(const LogNormalMode& mode, double wavelength_nm, const QuadratureOptions& options) {
-  return 2.0 * kPi / (wavelength_nm * 1e-9) * std::exp(QuadratureDomain(mode, options).u_hi);
+  const double k = 2.0 * kPi / (wavelength_nm * 1e-9);
+  return k * std::exp(QuadratureDomain(mode, k, options).u_hi);
 }
 
 PhaseTables MakePhaseTables(const PhaseGrid& grid, int max_terms, size_t check_stride) {

@@ -13,10 +13,12 @@
 // Radius quadrature (docs/mie.md, "Radius quadrature"):
 //   - modes with the same refractive index share one radius grid: each node (one Mie
 //     evaluation) serves every such mode, weighted by sum_i f_i n_i(u);
-//   - a mode's domain: [ln r_min, ln r_max] intersected with [ln r_g - 8 s, ln r_g + 6 s^2 + 8 s].
-//     Outside it every power-law weight r^p n(r), 0 <= p <= 6 (Rayleigh scattering ~ r^6 through
-//     geometric optics ~ r^2) is below Phi(-8) = 6e-16 of its total, so nothing measurable is
-//     left out; the normalisation uses the full [r_min, r_max] (analytic, erf);
+//   - a mode's domain: the part of [ln r_min, ln r_max] outside which the weights that the cross
+//     sections can have hold less than 1e-10 of their mass inside [r_min, r_max]: r^2 n(r)
+//     (geometric optics, C <= Q_max pi r^2), and r^6 n(r) (Rayleigh scattering, C ~ x^4 pi r^2)
+//     as long as x < 5 (beyond, Q is bounded and the r^2 bound rules); absorption (~ r^3) lies
+//     between. Each is a log-normal with the same s, centred at ln r_g + p s^2 (Hatch-Choate),
+//     so the cut-offs follow from erfc. The normalisation uses the full [r_min, r_max] (erf);
 //   - panels: the union of every mode's partition of its domain into pieces of width <= s/2;
 //     each panel lies wholly inside or outside each mode's domain, so a truncated mode is the
 //     exact composite trapezoid on its own domain. Panel p gets n_p = max(1, ceil(Delta x_p / 2))
@@ -49,7 +51,7 @@ struct QuadratureOptions {
   double x_step_start = 2.0;       // level-0 spacing in size parameter, at most
   double x_step_accept = 0.5;      // convergence is accepted only at this spacing or finer
   double u_step_start_sigmas = 0.5;  // level-0 spacing in ln r, at most, in units of s
-  double window_sigmas = 8.0;      // the domain described above
+  double window_tail = 1e-10;      // the domain described above
   int max_levels = 16;
   int min_levels = 0;              // refine at least this many times (tests of convergence)
 };
