@@ -17,6 +17,20 @@ inline std::filesystem::path Profiles(const std::string& atm) {
   return std::filesystem::path(atm) / "profiles.exr";
 }
 
+// outputs/components/particles/<type>.yaml: the canonical component of a particle type (its
+// file's stem), shared by every atmosphere that uses the type.
+inline std::filesystem::path ParticleComponent(const std::string& type) {
+  return std::filesystem::path("components") / "particles" / (type + ".yaml");
+}
+// outputs/mie/<type>.exr: mie-tables' table of a particle type (optics/mie_table.h).
+inline std::filesystem::path MieTable(const std::string& type) {
+  return std::filesystem::path("mie") / (type + ".exr");
+}
+// outputs/mie/<type>.report.json: its report (quadrature counts, convergence, fit errors).
+inline std::filesystem::path MieReport(const std::string& type) {
+  return std::filesystem::path("mie") / (type + ".report.json");
+}
+
 // outputs/clouds/noise/<volume><ext>: noise-gen's volume (the recipe file's stem), ext ".ktx2"
 // (the product), ".exr" (float field) or ".png" (slice montage).
 inline std::filesystem::path CloudNoise(const std::string& volume, const std::string& ext) {
