@@ -4,11 +4,13 @@
 // field's CDF calibration) and the coverage texture. Times include normalisation and texel
 // encoding (what noise-gen / cumulus-map do besides file I/O).
 //
-//   build/release/bin/bench_noise [--benchmark_repetitions=3]
-// Reports wall time per texture and voxels per second (counter "voxels/s").
+//   build/release/bin/bench_noise --benchmark_repetitions=7 --benchmark_report_aggregates_only=true
+// Reports wall time per texture and texels per second (counter "voxels/s"); with repetitions also
+// the minimum ("_min"), the figure to quote when other processes share the cores.
 #include <benchmark/benchmark.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "lut/ktx2.h"
@@ -71,11 +73,14 @@ void BM_CoverageTexture(benchmark::State& state) {
                  std::to_string(spec.types.size()) + " layers");
 }
 
+// The minimum over repetitions: the robust estimate when other processes share the 2 cores.
+double Min(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
+
 }  // namespace
 
-BENCHMARK_CAPTURE(BM_Volume, gt7_low_128, "clouds/noise_low.yaml")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_Volume, gt7_high_32, "clouds/noise_high.yaml")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK_CAPTURE(BM_Volume, shape_rgba_128, "clouds/noise_shape_rgba.yaml")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_CumulusMap)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_CoverageTexture)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK_CAPTURE(BM_Volume, gt7_low_128, "clouds/noise_low.yaml")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->ComputeStatistics("min", Min);
+BENCHMARK_CAPTURE(BM_Volume, gt7_high_32, "clouds/noise_high.yaml")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->ComputeStatistics("min", Min);
+BENCHMARK_CAPTURE(BM_Volume, shape_rgba_128, "clouds/noise_shape_rgba.yaml")->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->ComputeStatistics("min", Min);
+BENCHMARK(BM_CumulusMap)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->ComputeStatistics("min", Min);
+BENCHMARK(BM_CoverageTexture)->Unit(benchmark::kMillisecond)->UseRealTime()->ComputeStatistics("min", Min);
 BENCHMARK_MAIN();
