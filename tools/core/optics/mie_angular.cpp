@@ -33,29 +33,6 @@ AngularTables::AngularTables(const PhaseGrid& grid, int max_terms)
 
 namespace detail {
 
-// G += sum over the batch of w (x x^T + y y^T) for (x, y) = (Re, Im) of alpha (into ga) and of
-// beta (into gb), lower triangle, rows n < terms. buf holds, per batch slot r, the arrays
-// [ar, ai, br, bi, w ar, w ai, w br, w bi] of n values each.
-__attribute__((target_clones("avx512f", "avx2", "default")))
-void GramUpdate(double* ga, double* gb, size_t n, size_t terms, const double* buf, size_t count) {
-  for (size_t row = 0; row < terms; ++row) {
-    double* ra = ga + row * n;
-    double* rb = gb + row * n;
-    for (size_t r = 0; r < count; ++r) {
-      const double* b = buf + r * 8 * n;
-      const double* ar = b;
-      const double* ai = b + n;
-      const double* br = b + 2 * n;
-      const double* bi = b + 3 * n;
-      const double war = b[4 * n + row], wai = b[5 * n + row], wbr = b[6 * n + row], wbi = b[7 * n + row];
-      for (size_t c = 0; c <= row; ++c) {
-        ra[c] += war * ar[c] + wai * ai[c];
-        rb[c] += wbr * br[c] + wbi * bi[c];
-      }
-    }
-  }
-}
-
 // Eight doubles as one value (GCC vector extension): explicit lanes, so every lane does the same
 // operations in the same order whatever the instruction set (one AVX-512 register, two AVX2
 // registers or four SSE2 registers).
@@ -72,11 +49,44 @@ __attribute__((always_inline)) inline V8 Load8(const double* p) {
 }
 __attribute__((always_inline)) inline V8 Splat8(double x) { return V8{x, x, x, x, x, x, x, x}; }
 
+// G += sum over the batch of w (x x^T + y y^T) for (x, y) = (Re, Im) of alpha (into ga) and of
+// beta (into gb), lower triangle, rows < terms. buf holds, per batch slot r, the arrays
+// [ar, ai, br, bi] of `stride` values (zero beyond the radius' terms) and w_i = the weighted
+// values at each row. Rows are processed in blocks of 8 columns held in registers across the
+// batch (the columns past the diagonal, up to the block's end, are padding: never read back).
+__attribute__((target_clones("avx512f", "avx2", "default")))
+void GramUpdate(double* ga, double* gb, size_t stride, size_t terms, const double* buf, const double* wbuf,
+                size_t count) {
+  constexpr size_t kMax = 8;
+  for (size_t row = 0; row < terms; ++row) {
+    double* ra = ga + row * stride;
+    double* rb = gb + row * stride;
+    V8 war[kMax], wai[kMax], wbr[kMax], wbi[kMax];
+    for (size_t r = 0; r < count; ++r) {
+      const double* w = wbuf + r * 4 * stride;
+      war[r] = Splat8(w[row]);
+      wai[r] = Splat8(w[stride + row]);
+      wbr[r] = Splat8(w[2 * stride + row]);
+      wbi[r] = Splat8(w[3 * stride + row]);
+    }
+    for (size_t c = 0; c <= row; c += 8) {
+      V8 va = Load8(ra + c), vb = Load8(rb + c);
+      for (size_t r = 0; r < count; ++r) {
+        const double* b = buf + r * 4 * stride + c;
+        va += war[r] * Load8(b) + wai[r] * Load8(b + stride);
+        vb += wbr[r] * Load8(b + 2 * stride) + wbi[r] * Load8(b + 3 * stride);
+      }
+      __builtin_memcpy(ra + c, &va, sizeof(va));
+      __builtin_memcpy(rb + c, &vb, sizeof(vb));
+    }
+  }
+}
+
 // out[j] = (p^T G_A p + q^T G_B q)/4 at +mu_j and (q~^T G_A q~ + p~^T G_B p~)/4 at -mu_j, using
 // x^T G x = sum_n x_n (G_nn x_n + 2 sum_{n' < n} G_nn' x_n'); the inner sums run in four
 // interleaved partial sums (n' mod 4) to hide the addition latency.
 __attribute__((target_clones("avx512f", "avx2", "default")))
-void GramEvaluate(const double* ga, const double* gb, size_t n, size_t terms, const double* tables,
+void GramEvaluate(const double* ga, const double* gb, size_t stride, size_t terms, const double* tables,
                   size_t tiles, size_t tile_stride, size_t half, double* out) {
   constexpr size_t T = AngularTables::kTile;
   constexpr size_t R = AngularTables::kRow;
@@ -89,7 +99,7 @@ void GramEvaluate(const double* ga, const double* gb, size_t n, size_t terms, co
       const double* tx = tile + (which == 0 ? 0 : 2 * T);  // (p, q~) with G_A; (q, p~) with G_B
       V8 acc_x = Splat8(0.0), acc_y = Splat8(0.0);
       for (size_t row = 0; row < terms; ++row) {
-        const double* gr = g + row * n;
+        const double* gr = g + row * stride;
         V8 sx0 = Splat8(0.0), sx1 = sx0, sx2 = sx0, sx3 = sx0, sy0 = sx0, sy1 = sx0, sy2 = sx0, sy3 = sx0;
         size_t c = 0;
         for (; c + 4 <= row; c += 4) {
@@ -132,32 +142,39 @@ void GramEvaluate(const double* ga, const double* gb, size_t n, size_t terms, co
 
 IntensityAccumulator::IntensityAccumulator(int max_terms)
     : n_(max_terms),
-      ga_(static_cast<size_t>(max_terms) * max_terms, 0.0),
-      gb_(static_cast<size_t>(max_terms) * max_terms, 0.0),
-      buf_(kBatch * 8 * static_cast<size_t>(max_terms), 0.0) {
+      stride_((static_cast<size_t>(max_terms) + 7) / 8 * 8),
+      ga_(stride_ * stride_, 0.0),
+      gb_(stride_ * stride_, 0.0),
+      buf_(kBatch * 4 * stride_, 0.0),
+      wbuf_(kBatch * 4 * stride_, 0.0),
+      slot_len_(kBatch, 0) {
   SKYBAKE_CHECK_GE(max_terms, 1);
 }
 
 void IntensityAccumulator::Add(const MieCoefficients& c, double weight) {
   SKYBAKE_CHECK_LE(c.terms, n_);
   if (count_ == kBatch) Flush();
-  double* b = buf_.data() + count_ * 8 * static_cast<size_t>(n_);
-  const size_t n = static_cast<size_t>(n_);
-  // Slots are zero beyond the radius' own terms (they may hold an earlier radius' values).
-  std::fill(b, b + 8 * n, 0.0);
-  for (int i = 1; i <= c.terms; ++i) {
-    const double cn = (2.0 * i + 1.0) / (static_cast<double>(i) * (i + 1.0));
-    const Complex alpha = cn * (c.a[i - 1] + c.b[i - 1]);
-    const Complex beta = cn * (c.a[i - 1] - c.b[i - 1]);
-    const size_t j = static_cast<size_t>(i - 1);
+  double* b = buf_.data() + count_ * 4 * stride_;
+  double* w = wbuf_.data() + count_ * 4 * stride_;
+  const size_t n = static_cast<size_t>(c.terms);
+  // The slot may hold a longer earlier radius: zero what this one does not overwrite.
+  if (slot_len_[count_] > n) {
+    for (size_t k = 0; k < 4; ++k) std::fill(b + k * stride_ + n, b + k * stride_ + slot_len_[count_], 0.0);
+  }
+  slot_len_[count_] = std::max(slot_len_[count_], n);
+  for (size_t j = 0; j < n; ++j) {
+    const double i = static_cast<double>(j + 1);
+    const double cn = (2.0 * i + 1.0) / (i * (i + 1.0));
+    const Complex alpha = cn * (c.a[j] + c.b[j]);
+    const Complex beta = cn * (c.a[j] - c.b[j]);
     b[j] = alpha.real();
-    b[n + j] = alpha.imag();
-    b[2 * n + j] = beta.real();
-    b[3 * n + j] = beta.imag();
-    b[4 * n + j] = weight * alpha.real();
-    b[5 * n + j] = weight * alpha.imag();
-    b[6 * n + j] = weight * beta.real();
-    b[7 * n + j] = weight * beta.imag();
+    b[stride_ + j] = alpha.imag();
+    b[2 * stride_ + j] = beta.real();
+    b[3 * stride_ + j] = beta.imag();
+    w[j] = weight * alpha.real();
+    w[stride_ + j] = weight * alpha.imag();
+    w[2 * stride_ + j] = weight * beta.real();
+    w[3 * stride_ + j] = weight * beta.imag();
   }
   batch_terms_ = std::max(batch_terms_, c.terms);
   used_ = std::max(used_, c.terms);
@@ -166,7 +183,7 @@ void IntensityAccumulator::Add(const MieCoefficients& c, double weight) {
 
 void IntensityAccumulator::Flush() {
   if (count_ == 0) return;
-  detail::GramUpdate(ga_.data(), gb_.data(), static_cast<size_t>(n_), static_cast<size_t>(batch_terms_), buf_.data(),
+  detail::GramUpdate(ga_.data(), gb_.data(), stride_, static_cast<size_t>(batch_terms_), buf_.data(), wbuf_.data(),
                      count_);
   count_ = 0;
   batch_terms_ = 0;
@@ -182,7 +199,7 @@ void IntensityAccumulator::Evaluate(const AngularTables& tables, std::span<doubl
   SKYBAKE_CHECK_EQ(out.size(), 2 * tables.half() - 1);
   SKYBAKE_CHECK_LE(used_, tables.max_terms());
   Flush();
-  detail::GramEvaluate(ga_.data(), gb_.data(), static_cast<size_t>(n_), static_cast<size_t>(used_), tables.Tile(0),
+  detail::GramEvaluate(ga_.data(), gb_.data(), stride_, static_cast<size_t>(used_), tables.Tile(0),
                        tables.tiles(), static_cast<size_t>(tables.max_terms()) * AngularTables::kRow, tables.half(),
                        out.data());
 }

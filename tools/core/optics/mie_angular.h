@@ -83,14 +83,17 @@ class IntensityAccumulator {
   void Flush();
 
   int n_;
-  std::vector<double> ga_, gb_;  // row-major n_ x n_, lower triangle used
-  // Buffered radii: weighted and plain real/imaginary parts of alpha and beta, zero-padded to
-  // kBatchTerms = the largest N of the batch.
+  size_t stride_;                // n_ rounded up to a multiple of 8 (row length of G and buffers)
+  std::vector<double> ga_, gb_;  // row-major, lower triangle used
+  // Buffered radii (added in batches of kBatch, in order): per slot the real and imaginary parts
+  // of alpha and beta (buf_) and the same times the weight (wbuf_), 4 arrays of stride_ values,
+  // zero beyond the radius' terms.
   static constexpr size_t kBatch = 8;
   size_t count_ = 0;
   int batch_terms_ = 0;
   int used_ = 0;  // largest N added (rows beyond it are zero)
-  std::vector<double> buf_;  // kBatch x 8 arrays of n_ values
+  std::vector<double> buf_, wbuf_;
+  std::vector<size_t> slot_len_;  // entries of each slot that may be non-zero
 };
 
 }  // namespace skybake::mie

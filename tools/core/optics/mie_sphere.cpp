@@ -169,6 +169,15 @@ MieEfficiencies Efficiencies(const MieCoefficients& c) {
 
 void Amplitudes(const MieCoefficients& c, std::span<const double> mu, std::vector<Complex>& s1,
                 std::vector<Complex>& s2) {
+  // c_n a_n and c_n b_n once (c_n = (2n+1)/(n(n+1))); then per angle the recurrences and sums.
+  // The recurrence keeps its division by n: pi_n(+-1) and tau_n(+-1) then come out exactly equal
+  // in magnitude, so S1(0) = S2(0) and S1(180) = -S2(180) hold to the last bit.
+  std::vector<Complex> fa(c.terms), fb(c.terms);
+  for (int n = 1; n <= c.terms; ++n) {
+    const double f = (2.0 * n + 1.0) / (static_cast<double>(n) * (n + 1.0));
+    fa[n - 1] = f * c.a[n - 1];
+    fb[n - 1] = f * c.b[n - 1];
+  }
   s1.assign(mu.size(), Complex(0.0));
   s2.assign(mu.size(), Complex(0.0));
   for (size_t j = 0; j < mu.size(); ++j) {
@@ -177,11 +186,8 @@ void Amplitudes(const MieCoefficients& c, std::span<const double> mu, std::vecto
     Complex sum1(0.0), sum2(0.0);
     for (int n = 1; n <= c.terms; ++n) {
       const double tau_n = n * u * pi_n - (n + 1.0) * pi_prev;
-      const double f = (2.0 * n + 1.0) / (static_cast<double>(n) * (n + 1.0));
-      const Complex& a = c.a[n - 1];
-      const Complex& b = c.b[n - 1];
-      sum1 += f * (a * pi_n + b * tau_n);
-      sum2 += f * (a * tau_n + b * pi_n);
+      sum1 += fa[n - 1] * pi_n + fb[n - 1] * tau_n;
+      sum2 += fa[n - 1] * tau_n + fb[n - 1] * pi_n;
       const double pi_next = ((2.0 * n + 1.0) * u * pi_n - (n + 1.0) * pi_prev) / n;
       pi_prev = pi_n;
       pi_n = pi_next;
