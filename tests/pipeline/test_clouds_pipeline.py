@@ -30,9 +30,16 @@ channels:
   - worley: {frequency: 2, weights: [0.625, 0.25, 0.125]}
 """
 
+# A minimal atmosphere (no aerosols, so no mie-tables edges): the clouds do not depend on it, but
+# pipeline.yaml requires one.
+ATMOSPHERE = """name: plain
+planet: {radius_km: 6371, top_km: 100}
+air: {profile: ussa1976}
+"""
+
 PIPELINE = """outputs: outputs
 atmospheres:
-  - atmospheres/clear.yaml
+  - atmospheres/plain.yaml
 clouds:
   noise: [clouds/low.yaml, clouds/high.yaml]
   cumulus: clouds/cumulus.yaml
@@ -42,15 +49,15 @@ clouds:
 
 
 def edges_run(ninja_stdout):
-    return [m.group(1) for m in re.finditer(r"^\[\d+/\d+\] (.*)$", ninja_stdout, re.M) if "Regenerating" not in m.group(1)]
+    """The cloud edges ninja ran ("[1/2] noise-gen x" -> "noise-gen x"); other stages are ignored."""
+    return [m.group(1) for m in re.finditer(r"^\[\d+/\d+\] (.*)$", ninja_stdout, re.M)
+            if m.group(1).startswith(("noise-gen ", "cumulus-map "))]
 
 
 class CloudsPipelineTest(TempDirTestCase):
     def setUp(self):
         super().setUp()
-        shutil.copytree(os.path.join(SRC, "atmospheres"), self.path("atmospheres"))
-        if os.path.isdir(os.path.join(SRC, "particles")):
-            shutil.copytree(os.path.join(SRC, "particles"), self.path("particles"))
+        self.write("atmospheres/plain.yaml", ATMOSPHERE)
         os.makedirs(self.path("clouds"))
         for name in ("cumulus.yaml", "coverage.yaml"):
             shutil.copy(os.path.join(SRC, "clouds", name), self.path("clouds", name))
@@ -73,7 +80,7 @@ class CloudsPipelineTest(TempDirTestCase):
 
     def test_fresh_bake_builds_every_cloud_product_then_no_work(self):
         r = self.bake()
-        self.assertEqual(sorted(e for e in edges_run(r.stdout) if not e.startswith("profile-import")), [
+        self.assertEqual(sorted(edges_run(r.stdout)), [
             "cumulus-map clouds/coverage.ktx2", "cumulus-map clouds/cumulus_map_t0s.ktx2",
             "noise-gen clouds/noise/high.ktx2", "noise-gen clouds/noise/low.ktx2"])
         for rel in ("clouds/noise/low.ktx2", "clouds/noise/low.exr", "clouds/noise/low.png", "clouds/noise/high.ktx2",
