@@ -76,7 +76,7 @@ class MieTablesCli(CliContract, TempDirTestCase):
         self.assertEqual(info.returncode, 0, info.stderr)
         self.assertIn("cext_m2", info.stdout)
         self.assertIn("phase_sr", info.stdout)
-        self.assertIn("1827 x    3", info.stdout)
+        self.assertIn("2161 x    3", info.stdout)
         attrs = exr_attributes(out)
         self.assertEqual(attrs["skybake.tool"], "mie-tables")
         self.assertEqual(attrs["skybake.mie.particle"], "gt7_case_study")
@@ -90,7 +90,7 @@ class MieTablesCli(CliContract, TempDirTestCase):
         with open(self.path("gt7.report.json")) as f:
             report = json.load(f)
         self.assertEqual(report["wavelengths_nm"], {"count": 3, "min": 450, "max": 650})
-        self.assertEqual(report["angles"], 1827)
+        self.assertEqual(report["angles"], 2161)
         self.assertEqual([m["name"] for m in report["modes"]],
                          ["fine", "accumulation_1", "accumulation_2", "accumulation_3", "coarse"])
         self.assertAlmostEqual(sum(m["number_fraction"] for m in report["modes"]), 1.0, places=12)
@@ -110,7 +110,7 @@ class MieTablesCli(CliContract, TempDirTestCase):
         phase = run([tool("mie-tables"), "dump", out, "--what", "phase", "--wavelength-nm", "550"])
         self.assertEqual(phase.returncode, 0, phase.stderr)
         prow = list(csv.DictReader(io.StringIO("\n".join(phase.stdout.splitlines()[1:]))))
-        self.assertEqual(len(prow), 1827)
+        self.assertEqual(len(prow), 2161)
         self.assertEqual(float(prow[0]["cdf"]), 0.0)
         self.assertEqual(float(prow[-1]["cdf"]), 1.0)
         # int P dOmega = 1 on the table's grid (trapezoid in mu; the interpolant's exact rule is

@@ -188,7 +188,7 @@ std::vector<ExrPart> MieTableParts(const MieTable& t, const Provenance& provenan
 
   ExrTable phase;
   phase.axes = {ExrAxis{"theta", "rad",
-                        "scattering angle, 0 = forward; log-spaced 0.001-1 deg and its mirror about 90 deg, 0.125 deg "
+                        "scattering angle, 0 = forward; log-spaced 0.01-5 deg and its mirror about 90 deg, 0.125 deg "
                         "steps between (docs/mie.md)",
                         t.theta_rad},
                 wl_axis};

@@ -9,10 +9,10 @@ namespace skybake::mie {
 
 namespace {
 constexpr double kDeg = std::numbers::pi / 180.0;
-// Log-spaced part: 0.001 deg .. 1 deg with 201 points; uniform part: 1 deg .. 90 deg, 0.125 deg.
-constexpr double kLogStartDeg = 0.001;
-constexpr double kLogEndDeg = 1.0;
-constexpr int kLogPoints = 201;
+// Log-spaced part: 0.01 deg .. 5 deg with 400 points; uniform part: 5 deg .. 90 deg, 0.125 deg.
+constexpr double kLogStartDeg = 0.01;
+constexpr double kLogEndDeg = 5.0;
+constexpr int kLogPoints = 400;
 constexpr double kUniformStepDeg = 0.125;
 }  // namespace
 
