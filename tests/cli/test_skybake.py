@@ -12,6 +12,7 @@ class SkybakeCli(CliContract, TempDirTestCase):
     def setUp(self):
         super().setUp()
         shutil.copytree(os.path.join(SRC, "atmospheres"), self.path("atmospheres"))
+        shutil.copytree(os.path.join(SRC, "particles"), self.path("particles"))
         self.write("pipeline.yaml", "atmospheres: [atmospheres/clear.yaml]\n")
 
     def test_generate_output_is_read_by_ninja(self):

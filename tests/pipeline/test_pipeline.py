@@ -16,11 +16,27 @@ from skytest import SRC, TempDirTestCase, run, tool  # noqa: E402
 
 PIPELINE = """outputs: outputs
 altitude_step_m: 100
+wavelengths: {min_nm: 400, max_nm: 700, step_nm: 50}
 atmospheres:
   - atmospheres/clear.yaml
   - atmospheres/hazed.yaml
 pools:
   render: 1
+sky: {size: 4x2, sun_zenith_deg: [40], target_error: 0.5, preview: false}
+"""
+
+# A cheap particle type for the pipeline tests (small droplets: few Mie terms), replacing the
+# atmospheres' real types so that a bake takes seconds. Both atmospheres share it: one Mie edge.
+TINY_PARTICLE = """refractive_index:
+  table: ../atmospheres/data/water_refractive_index_segelstein_1981.csv
+modes:
+  - name: small
+    basis: number
+    median_radius_um: 0.1
+    sigma_g: 1.5
+    r_min_um: 0.02
+    r_max_um: 0.5
+    weight: {relative_number: 1.0}
 """
 
 
@@ -37,6 +53,14 @@ class PipelineTest(TempDirTestCase):
             if os.path.isdir(os.path.join(SRC, extra)):
                 shutil.copytree(os.path.join(SRC, extra), self.path(extra))
         self.write("pipeline.yaml", PIPELINE)
+        self.write("particles/tiny.yaml", TINY_PARTICLE)
+        for atm in ("clear", "hazed"):
+            p = self.path("atmospheres", atm + ".yaml")
+            with open(p) as f:
+                text = f.read()
+            text = re.sub(r"particle: \.\./particles/\w+\.yaml", "particle: ../particles/tiny.yaml", text)
+            with open(p, "w") as f:
+                f.write(text)
         self.out = self.path("outputs")
 
     def bake(self):
@@ -68,8 +92,9 @@ class PipelineTest(TempDirTestCase):
     def test_fresh_bake_then_no_work(self):
         r = self.bake()
         self.assertEqual(sorted(edges_run(r.stdout)),
-                         ["mie-tables mie/continental.exr",  # clear.yaml's aerosol particle type
-                          "profile-import clear/profiles.exr", "profile-import hazed/profiles.exr"])
+                         ["mie-tables mie/tiny.exr",  # the particle type both atmospheres share here
+                          "profile-import clear/profiles.exr", "profile-import hazed/profiles.exr",
+                          "sky-render clear/sky.exr", "sky-render hazed/sky.exr"])
         for atm in ("clear", "hazed"):
             self.assertTrue(os.path.isfile(os.path.join(self.out, atm, "profiles.exr")))
         self.assertIn("no work to do", self.ninja("-n").stdout)
@@ -85,7 +110,9 @@ class PipelineTest(TempDirTestCase):
         before = self.mtimes()
         self.edit("atmospheres/hazed.yaml", "extinction_550nm_per_km_vis5", "extinction_550nm_per_km_vis10")
         r = self.ninja("-d", "explain")
-        self.assertEqual(edges_run(r.stdout), ["Regenerating build.ninja", "profile-import hazed/profiles.exr"])
+        # hazed's profiles change, so its sky is re-rendered; nothing of clear, no Mie table.
+        self.assertEqual(edges_run(r.stdout), ["Regenerating build.ninja", "profile-import hazed/profiles.exr",
+                                               "sky-render hazed/sky.exr"])
         after = self.mtimes()
         self.assertEqual(before["clear/profiles.exr"], after["clear/profiles.exr"])
         self.assertEqual(before["clear/components/profiles.yaml"], after["clear/components/profiles.yaml"])
@@ -100,7 +127,25 @@ class PipelineTest(TempDirTestCase):
         self.edit("atmospheres/data/hazed_private.csv", "\n1,4.150e-02,9.910e-02,3.790e-01,7.700e-01\n",
                   "\n1,4.150e-02,9.910e-02,3.790e-01,6.500e-01\n")
         r = self.ninja()
-        self.assertEqual(edges_run(r.stdout), ["profile-import hazed/profiles.exr"])
+        self.assertEqual(edges_run(r.stdout), ["profile-import hazed/profiles.exr", "sky-render hazed/sky.exr"])
+
+    def test_editing_render_only_settings_reruns_only_the_sky(self):
+        self.bake()
+        before = self.mtimes()
+        self.edit("atmospheres/hazed.yaml", "optical_depth_550nm: 0.5", "optical_depth_550nm: 0.6")
+        r = self.ninja()
+        self.assertEqual(edges_run(r.stdout), ["Regenerating build.ninja", "sky-render hazed/sky.exr"])
+        after = self.mtimes()
+        self.assertEqual(before["hazed/profiles.exr"], after["hazed/profiles.exr"])
+        self.assertEqual(before["mie/tiny.exr"], after["mie/tiny.exr"])
+        self.assertEqual(before["clear/sky.exr"], after["clear/sky.exr"])
+
+    def test_editing_a_particle_type_reruns_its_mie_table_and_the_skies_using_it(self):
+        self.bake()
+        self.edit("particles/tiny.yaml", "sigma_g: 1.5", "sigma_g: 1.6")
+        r = self.ninja()
+        self.assertEqual(sorted(edges_run(r.stdout)), ["Regenerating build.ninja", "mie-tables mie/tiny.exr",
+                                                       "sky-render clear/sky.exr", "sky-render hazed/sky.exr"])
 
     def test_comment_and_whitespace_edits_rerun_nothing_downstream(self):
         self.bake()
@@ -124,6 +169,7 @@ class PipelineTest(TempDirTestCase):
         self.assertEqual(edges_run(r.stdout), ["Regenerating build.ninja"])
         r = self.ninja("-t", "cleandead")
         self.assertFalse(os.path.exists(os.path.join(self.out, "hazed", "profiles.exr")))
+        self.assertFalse(os.path.exists(os.path.join(self.out, "hazed", "sky.exr")))
         self.assertFalse(os.path.exists(os.path.join(self.out, "hazed", "components", "profiles.yaml")))
         self.assertTrue(os.path.exists(os.path.join(self.out, "clear", "profiles.exr")))
         self.assertIn("no work to do", self.ninja("-n").stdout)
@@ -179,7 +225,7 @@ class PipelineTest(TempDirTestCase):
         self.edit("pipeline.yaml", "pools:", "launchers:\n  profile-imprt: srun\npools:")
         r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)
         self.assertEqual(r.returncode, 1)
-        self.assertIn("pipeline.yaml:7: unknown key 'launchers.profile-imprt' (did you mean 'profile-import'?)", r.stderr)
+        self.assertIn("pipeline.yaml:8: unknown key 'launchers.profile-imprt' (did you mean 'profile-import'?)", r.stderr)
 
 
 class KillMidWriteTest(TempDirTestCase):

@@ -69,7 +69,9 @@ int main(int argc, char** argv) {
   CLI::App* render = cli.app().add_subcommand("render", "Sky images (EXR, multi-part) for a list of sun zenith angles");
   add_scene_options(render);
   RenderOptions ro;
-  render->add_option("--method", ro.method, "Rendering method: path")->default_val("path");
+  render->add_option("--method", ro.method, "Rendering method: path (the Monte-Carlo reference), single, orders, ms-approx, analytic")
+      ->default_val("path");
+  render->add_option("--quality", ro.method_options.quality, "Deterministic methods: low, medium or high")->default_val("medium");
   render->add_option("--mapping", ro.mapping, "Direction mapping: equirectangular or fisheye")->default_val("equirectangular");
   render->add_option("--size", ro.size, "Image size WxH")->default_val("64x32");
   render->add_option("--sun-zenith-deg", ro.sun_zenith_deg, "Sun zenith angles (deg), comma separated")

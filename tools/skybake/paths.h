@@ -17,6 +17,14 @@ inline std::filesystem::path Profiles(const std::string& atm) {
   return std::filesystem::path(atm) / "profiles.exr";
 }
 
+// outputs/<atm>/components/render.yaml: what the renderers need besides the profiles.
+inline std::filesystem::path RenderComponent(const std::string& atm) {
+  return std::filesystem::path(atm) / "components" / "render.yaml";
+}
+// outputs/<atm>/sky.exr and sky.png: sky-render's render and preview.
+inline std::filesystem::path Sky(const std::string& atm) { return std::filesystem::path(atm) / "sky.exr"; }
+inline std::filesystem::path SkyPreview(const std::string& atm) { return std::filesystem::path(atm) / "sky.png"; }
+
 // outputs/components/particles/<type>.yaml: the canonical component of a particle type (its
 // file's stem), shared by every atmosphere that uses the type.
 inline std::filesystem::path ParticleComponent(const std::string& type) {

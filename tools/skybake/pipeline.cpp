@@ -12,7 +12,7 @@ namespace fs = std::filesystem;
 
 namespace skybake {
 
-std::vector<double> WavelengthGrid::Values() const {
+std::vector<double> PipelineWavelengths::Values() const {
   std::vector<double> v;
   const size_t n = static_cast<size_t>(std::llround((max_nm - min_nm) / step_nm));
   for (size_t i = 0; i <= n; ++i) v.push_back(min_nm + static_cast<double>(i) * step_nm);

@@ -24,7 +24,7 @@ struct PipelineAtmosphere {
   AtmosphereSpec spec;         // grid resolved (pipeline default if the atmosphere has none)
 };
 
-struct WavelengthGrid {
+struct PipelineWavelengths {
   double min_nm = 360.0;
   double max_nm = 830.0;
   double step_nm = 5.0;
@@ -36,7 +36,7 @@ struct Pipeline {
   std::filesystem::path root_dir;  // its folder
   std::filesystem::path out_dir;   // absolute outputs folder
   double altitude_step_m = 100.0;
-  WavelengthGrid wavelengths;
+  PipelineWavelengths wavelengths;
   std::vector<PipelineAtmosphere> atmospheres;
   std::map<std::string, int> pools;
   std::map<std::string, std::string> launchers;

@@ -53,7 +53,7 @@ class MieTablesStage : public Stage {
     }
     diags.ThrowIfAny();
 
-    const WavelengthGrid& wl = ctx.pipeline().wavelengths;
+    const PipelineWavelengths& wl = ctx.pipeline().wavelengths;
     for (const auto& [name, file] : types) {
       ctx.AddRegenInput(file);
       const mie::ParticleType type = mie::LoadParticleType(file);

@@ -5,6 +5,7 @@ namespace skybake {
 
 std::unique_ptr<Stage> MakeProfileImportStage();
 std::unique_ptr<Stage> MakeMieTablesStage();
+std::unique_ptr<Stage> MakeSkyRenderStage();
 std::unique_ptr<Stage> MakeNoiseGenStage();
 std::unique_ptr<Stage> MakeCumulusMapStage();
 
@@ -12,6 +13,7 @@ std::vector<std::unique_ptr<Stage>> MakeStages() {
   std::vector<std::unique_ptr<Stage>> s;
   s.push_back(MakeProfileImportStage());
   s.push_back(MakeMieTablesStage());
+  s.push_back(MakeSkyRenderStage());
   s.push_back(MakeNoiseGenStage());
   s.push_back(MakeCumulusMapStage());  // after noise-gen: it owns the `clouds` section's unknown keys
   return s;

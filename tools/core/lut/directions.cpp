@@ -83,4 +83,25 @@ std::string DirectionGrid::Describe() const {
       width, height);
 }
 
+namespace {
+class StaticMapping : public SkyMapping {
+ public:
+  explicit StaticMapping(const DirectionGrid& g) : g_(g) {}
+  std::string Name() const override { return DirectionMappingName(g_.mapping); }
+  int width() const override { return g_.width; }
+  int height() const override { return g_.height; }
+  std::optional<std::array<double, 3>> TexelDirection(int x, int y, double) const override { return g_.TexelDirection(x, y); }
+  std::array<int, 2> Mirror(int x, int y) const override {
+    return g_.mapping == DirectionMapping::kEquirectangular ? std::array<int, 2>{g_.width - 1 - x, y}
+                                                            : std::array<int, 2>{x, g_.height - 1 - y};
+  }
+  std::string Describe() const override { return g_.Describe(); }
+
+ private:
+  DirectionGrid g_;
+};
+}  // namespace
+
+std::unique_ptr<SkyMapping> MakeStaticMapping(const DirectionGrid& grid) { return std::make_unique<StaticMapping>(grid); }
+
 }  // namespace skybake

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <array>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -45,5 +46,26 @@ struct DirectionGrid {
   // e.g. "equirectangular 64x32: u -> azimuth from the sun ..."; for EXR axis descriptions.
   std::string Describe() const;
 };
+
+// A direction parametrisation of a sky image that may depend on the sun's zenith angle (GT7's
+// sun-aligned mapping does; equirectangular and fisheye do not). RenderSky renders through this.
+class SkyMapping {
+ public:
+  virtual ~SkyMapping() = default;
+  virtual std::string Name() const = 0;
+  virtual int width() const = 0;
+  virtual int height() const = 0;
+  // The direction (local frame above) of texel (x, y)'s centre for a sun at `sun_zenith_rad`;
+  // nullopt outside the mapping.
+  virtual std::optional<std::array<double, 3>> TexelDirection(int x, int y, double sun_zenith_rad) const = 0;
+  // The texel that sees the mirror image of (x, y) in the sun's vertical plane (same radiance),
+  // or (x, y) itself when the mapping covers only one side.
+  virtual std::array<int, 2> Mirror(int x, int y) const = 0;
+  // For axis descriptions and provenance.
+  virtual std::string Describe() const = 0;
+};
+
+// The sun-independent mappings as SkyMapping.
+std::unique_ptr<SkyMapping> MakeStaticMapping(const DirectionGrid& grid);
 
 }  // namespace skybake

@@ -52,8 +52,9 @@ SkyRenderResult RenderSky(const PathTracer& tracer, const SkyRenderSettings& s, 
   const size_t nw = m.wavelengths();
   SkyRenderResult result;
   const glm::dvec3 observer(0.0, 0.0, m.bottom_radius_m + s.observer_altitude_m);
-  const DirectionGrid& g = s.directions;
-  const size_t texels = static_cast<size_t>(g.width) * static_cast<size_t>(g.height);
+  const SkyMapping& g = *s.mapping;
+  const int W = g.width(), H = g.height();
+  const size_t texels = static_cast<size_t>(W) * static_cast<size_t>(H);
 
   // Transmittance table.
   for (int a = 0; a < s.transmittance_angles; ++a) {
@@ -67,12 +68,11 @@ SkyRenderResult RenderSky(const PathTracer& tracer, const SkyRenderSettings& s, 
   // Texels to compute: one of each mirror pair.
   std::vector<size_t> work;
   std::vector<size_t> mirror(texels);
-  for (int y = 0; y < g.height; ++y) {
-    for (int x = 0; x < g.width; ++x) {
-      const size_t t = static_cast<size_t>(y) * g.width + x;
-      const size_t tm = g.mapping == DirectionMapping::kEquirectangular
-                            ? static_cast<size_t>(y) * g.width + (g.width - 1 - x)
-                            : static_cast<size_t>(g.height - 1 - y) * g.width + x;
+  for (int y = 0; y < H; ++y) {
+    for (int x = 0; x < W; ++x) {
+      const size_t t = static_cast<size_t>(y) * W + x;
+      const std::array<int, 2> mirrored = g.Mirror(x, y);
+      const size_t tm = static_cast<size_t>(mirrored[1]) * W + mirrored[0];
       mirror[t] = tm;
       if (t <= tm) work.push_back(t);
     }
@@ -92,8 +92,8 @@ SkyRenderResult RenderSky(const PathTracer& tracer, const SkyRenderSettings& s, 
     tbb::parallel_for(tbb::blocked_range<size_t>(0, work.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
       for (size_t k = range.begin(); k != range.end(); ++k) {
         const size_t t = work[k];
-        const int x = static_cast<int>(t % static_cast<size_t>(g.width)), y = static_cast<int>(t / static_cast<size_t>(g.width));
-        std::optional<std::array<double, 3>> d = g.TexelDirection(x, y);
+        const int x = static_cast<int>(t % static_cast<size_t>(W)), y = static_cast<int>(t / static_cast<size_t>(W));
+        std::optional<std::array<double, 3>> d = g.TexelDirection(x, y, theta_s);
         if (d) {
           const glm::dvec3 dir = glm::normalize(glm::dvec3((*d)[0], (*d)[1], (*d)[2]));
           const uint64_t stream = static_cast<uint64_t>(si) * texels + t;
@@ -123,6 +123,113 @@ SkyRenderResult RenderSky(const PathTracer& tracer, const SkyRenderSettings& s, 
     result.slices.push_back(std::move(slice));
   }
   result.total_paths = total_paths;
+  return result;
+}
+
+namespace {
+
+// Transmittance table and direct sun, shared by both renderers.
+void FillTransmittanceAndSun(const AtmosphereModel& m, const std::vector<std::array<double, 3>>& weights,
+                             const SkyRenderSettings& s, SkyRenderResult* result) {
+  const size_t nw = m.wavelengths();
+  for (int a = 0; a < s.transmittance_angles; ++a) {
+    const double zen = 180.0 * a / std::max(1, s.transmittance_angles - 1);
+    result->transmittance_zenith_deg.push_back(zen);
+    for (size_t w = 0; w < nw; ++w) {
+      result->transmittance.push_back(TransmittanceToSpace(m, s.observer_altitude_m, zen * kPi / 180.0, w));
+    }
+  }
+  for (SkySlice& slice : result->slices) {
+    const double theta_s = slice.sun_zenith_deg * kPi / 180.0;
+    slice.sun_irradiance.assign(nw, 0.0);
+    slice.sun_xyz = {0, 0, 0};
+    for (size_t w = 0; w < nw; ++w) {
+      slice.sun_irradiance[w] = m.sun.irradiance[w] * TransmittanceToSpace(m, s.observer_altitude_m, theta_s, w);
+      for (size_t c = 0; c < 3; ++c) slice.sun_xyz[c] += weights[w][c] * slice.sun_irradiance[w];
+    }
+  }
+}
+
+}  // namespace
+
+SkyRenderResult RenderSkyDeterministic(const SkyMethod& method, const AtmosphereModel& m,
+                                       const std::vector<std::array<double, 3>>& weights, const SkyRenderSettings& s,
+                                       const ProgressFn& progress) {
+  const size_t nw = m.wavelengths();
+  const SkyMapping& g = *s.mapping;
+  const int W = g.width(), H = g.height();
+  const size_t texels = static_cast<size_t>(W) * H;
+  SkyRenderResult result;
+  std::atomic<size_t> done{0};
+  const size_t total = s.sun_zenith_deg.size() * static_cast<size_t>(H);
+  for (double sza : s.sun_zenith_deg) {
+    SkySlice slice;
+    slice.sun_zenith_deg = sza;
+    const double theta_s = sza * kPi / 180.0;
+    slice.xyz.assign(texels * 3, std::numeric_limits<float>::quiet_NaN());
+    slice.y_stderr.assign(texels, 0.0f);
+    slice.paths.assign(texels, 0.0f);
+    tbb::parallel_for(tbb::blocked_range<int>(0, H, 1), [&](const tbb::blocked_range<int>& rows) {
+      for (int y = rows.begin(); y != rows.end(); ++y) {
+        std::vector<std::array<double, 3>> dirs;
+        std::vector<size_t> at;
+        for (int x = 0; x < W; ++x) {
+          const size_t t = static_cast<size_t>(y) * W + x;
+          const std::array<int, 2> mirrored = g.Mirror(x, y);
+          const size_t tm = static_cast<size_t>(mirrored[1]) * W + mirrored[0];
+          if (tm < t) continue;  // computed with its mirror
+          std::optional<std::array<double, 3>> d = g.TexelDirection(x, y, theta_s);
+          if (!d) continue;
+          dirs.push_back(*d);
+          at.push_back(t);
+        }
+        std::vector<double> L;
+        if (!dirs.empty()) method.Radiance(s.observer_altitude_m, theta_s, dirs, &L);
+        for (size_t k = 0; k < at.size(); ++k) {
+          std::array<double, 3> xyz{0, 0, 0};
+          for (size_t w = 0; w < nw; ++w) {
+            for (size_t c = 0; c < 3; ++c) xyz[c] += weights[w][c] * L[k * nw + w];
+          }
+          const int x = static_cast<int>(at[k] % static_cast<size_t>(W)), yy = static_cast<int>(at[k] / static_cast<size_t>(W));
+          const std::array<int, 2> mirrored = g.Mirror(x, yy);
+          for (size_t tt : {at[k], static_cast<size_t>(mirrored[1]) * W + mirrored[0]}) {
+            for (size_t c = 0; c < 3; ++c) slice.xyz[tt * 3 + c] = static_cast<float>(xyz[c]);
+          }
+        }
+        const size_t n = ++done;
+        if (progress) progress("sky radiance", static_cast<double>(n) / total);
+      }
+    });
+    if (s.ambient) {
+      // E = int_0^{2 pi} int_0^1 L mu dmu dphi = 2 int_0^pi ... (symmetric in phi).
+      static const double kX[8] = {0.0950125098376374, 0.2816035507792589, 0.4580167776572274, 0.6178762444026438,
+                                   0.7554044083550030, 0.8656312023878318, 0.9445750230732326, 0.9894009349916499};
+      static const double kW[8] = {0.1894506104550685, 0.1826034150449236, 0.1691565193950025, 0.1495959888165767,
+                                   0.1246289712555339, 0.0951585116824928, 0.0622535239386479, 0.0271524594117541};
+      std::vector<std::array<double, 3>> dirs;
+      std::vector<double> wt;
+      constexpr int kPhi = 32;
+      for (int k = 0; k < 16; ++k) {
+        const double mu = 0.5 + 0.5 * (k < 8 ? -kX[7 - k] : kX[k - 8]);
+        const double wmu = 0.5 * (k < 8 ? kW[7 - k] : kW[k - 8]);
+        for (int q = 0; q < kPhi; ++q) {
+          const double phi = kPi * (q + 0.5) / kPhi;
+          const double st = std::sqrt(std::max(0.0, 1.0 - mu * mu));
+          dirs.push_back({st * std::cos(phi), st * std::sin(phi), mu});
+          wt.push_back(2.0 * wmu * mu * kPi / kPhi);
+        }
+      }
+      std::vector<double> L;
+      method.Radiance(s.observer_altitude_m, theta_s, dirs, &L);
+      for (size_t d = 0; d < dirs.size(); ++d) {
+        for (size_t w = 0; w < nw; ++w) {
+          for (size_t c = 0; c < 3; ++c) slice.ambient.xyz[c] += wt[d] * weights[w][c] * L[d * nw + w];
+        }
+      }
+    }
+    result.slices.push_back(std::move(slice));
+  }
+  FillTransmittanceAndSun(m, weights, s, &result);
   return result;
 }
 

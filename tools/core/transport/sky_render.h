@@ -17,16 +17,18 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "io/progress.h"
 #include "lut/directions.h"
 #include "transport/path_tracer.h"
+#include "transport/sky_method.h"
 
 namespace skybake {
 
 struct SkyRenderSettings {
-  DirectionGrid directions;
+  std::shared_ptr<const SkyMapping> mapping;  // the texel directions (may depend on the sun)
   std::vector<double> sun_zenith_deg;
   double observer_altitude_m = 0.0;
   bool ambient = true;
@@ -51,6 +53,14 @@ struct SkyRenderResult {
 };
 
 SkyRenderResult RenderSky(const PathTracer& tracer, const SkyRenderSettings& settings, const ProgressFn& progress);
+
+// The same products from a deterministic method (transport/sky_method.h): standard errors and
+// path counts are 0; the ambient irradiance is the method's radiance integrated over the upper
+// hemisphere by Gauss-Legendre in cos(zenith) (16 nodes) x midpoint in azimuth (32 over the
+// half-circle, mirrored).
+SkyRenderResult RenderSkyDeterministic(const SkyMethod& method, const AtmosphereModel& model,
+                                       const std::vector<std::array<double, 3>>& xyz_weights,
+                                       const SkyRenderSettings& settings, const ProgressFn& progress);
 
 // Transmittance (exact for the piecewise-linear profile up to the quadrature: composite
 // Gauss-Legendre on 100 m of path) from a point at `altitude_m` along view zenith `zenith_rad`

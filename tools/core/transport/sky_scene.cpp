@@ -138,7 +138,6 @@ Scene LoadScene(const SceneOptions& o, const ProgressFn& progress) {
 }
 
 RenderProducts RenderProductsOf(const Scene& scene, const RenderOptions& o, const ProgressFn& progress) {
-  if (o.method != "path") throw UsageError("--method: expected path, got '" + o.method + "'");
   RenderProducts p;
   std::optional<DirectionMapping> mapping = ParseDirectionMapping(o.mapping);
   if (!mapping) throw UsageError("--mapping: expected equirectangular or fisheye, got '" + o.mapping + "'");
@@ -146,7 +145,7 @@ RenderProducts RenderProductsOf(const Scene& scene, const RenderOptions& o, cons
   if (std::sscanf(o.size.c_str(), "%dx%d", &w, &h) != 2 || w < 2 || h < 2 || w > 8192 || h > 8192) {
     throw UsageError("--size: expected WxH (2 to 8192), got '" + o.size + "'");
   }
-  p.settings.directions = DirectionGrid{*mapping, w, h};
+  p.settings.mapping = MakeStaticMapping(DirectionGrid{*mapping, w, h});
   for (double z : o.sun_zenith_deg) {
     if (!(z >= 0.0 && z <= 180.0)) throw UsageError(fmt::format("--sun-zenith-deg: {} is outside 0-180", z));
   }
@@ -155,8 +154,14 @@ RenderProducts RenderProductsOf(const Scene& scene, const RenderOptions& o, cons
   if (p.settings.observer_altitude_m >= scene.model.altitude_m.back()) {
     throw UsageError("the observer must be inside the atmosphere");
   }
-  PathTracer tracer(scene.model, scene.xyz_weights, scene.tracer);
-  p.sky = RenderSky(tracer, p.settings, progress);
+  if (o.method == "path") {
+    PathTracer tracer(scene.model, scene.xyz_weights, scene.tracer);
+    p.sky = RenderSky(tracer, p.settings, progress);
+  } else {
+    std::unique_ptr<SkyMethod> method = MakeSkyMethod(o.method, scene.model, o.method_options, progress);
+    p.sky = RenderSkyDeterministic(*method, scene.model, scene.xyz_weights, p.settings, progress);
+    p.method_description = method->Describe();
+  }
   return p;
 }
 
@@ -164,22 +169,23 @@ void WriteRender(const Scene& scene, const RenderOptions& o, const RenderProduct
                  const std::string& tool) {
   Provenance prov;
   prov.tool = tool;
-  prov.parameters = fmt::format("method: {}\nmapping: {}\nsize: {}\n", o.method, o.mapping, o.size) + scene.parameters;
+  prov.parameters = fmt::format("method: {}\nmapping: {}\nsize: {}\n", o.method, o.mapping, o.size) +
+                    p.method_description + scene.parameters;
   for (const fs::path& f : scene.files_read) prov.AddInput(f);
 
   ColorConfig config = ColorConfig::Load(scene.ocio_config);
   ColorProcessor to_reference = config.Converter(XyzColorSpace(scene.observer), ocio_names::kCieXyzD65);
-  const DirectionGrid& g = p.settings.directions;
+  const SkyMapping& g = *p.settings.mapping;
   const size_t nw = scene.grid.size();
   std::vector<ExrPart> parts;
   for (const SkySlice& sl : p.sky.slices) {
     std::vector<float> rgb = sl.xyz;
     to_reference.Apply(rgb);
-    ExrImage img = MakeColorImage(g.width, g.height, rgb, ocio_names::kCieXyzD65);
+    ExrImage img = MakeColorImage(g.width(), g.height(), rgb, ocio_names::kCieXyzD65);
     // Extra channels beside R, G, B.
     ExrImage full;
-    full.Resize(g.width, g.height, {"R", "G", "B", "Y_stderr", "paths"});
-    for (size_t t = 0; t < static_cast<size_t>(g.width) * g.height; ++t) {
+    full.Resize(g.width(), g.height(), {"R", "G", "B", "Y_stderr", "paths"});
+    for (size_t t = 0; t < static_cast<size_t>(g.width()) * g.height(); ++t) {
       for (size_t c = 0; c < 3; ++c) full.pixels[t * 5 + c] = rgb[t * 3 + c];
       full.pixels[t * 5 + 3] = sl.y_stderr[t];
       full.pixels[t * 5 + 4] = sl.paths[t];
@@ -251,8 +257,8 @@ void WriteRender(const Scene& scene, const RenderOptions& o, const RenderProduct
 
 void WriteRenderPreview(const Scene& scene, const RenderOptions& o, const RenderProducts& p, const fs::path& path) {
   ColorConfig config = ColorConfig::Load(scene.ocio_config);
-  const DirectionGrid& g = p.settings.directions;
-  const size_t texels = static_cast<size_t>(g.width) * g.height;
+  const SkyMapping& g = *p.settings.mapping;
+  const size_t texels = static_cast<size_t>(g.width()) * g.height();
   std::vector<uint8_t> montage;
   ColorProcessor to_reference = config.Converter(XyzColorSpace(scene.observer), ocio_names::kCieXyzD65);
   for (const SkySlice& sl : p.sky.slices) {
@@ -276,10 +282,10 @@ void WriteRenderPreview(const Scene& scene, const RenderOptions& o, const Render
       view.white_cd_m2 = *w;
     }
     ColorProcessor display = config.Display(ocio_names::kCieXyzD65, view);
-    std::vector<uint8_t> row = EncodePreview8(g.width, g.height, rgb, display);
+    std::vector<uint8_t> row = EncodePreview8(g.width(), g.height(), rgb, display);
     montage.insert(montage.end(), row.begin(), row.end());
   }
-  WritePng8(path, g.width, g.height * static_cast<int>(p.sky.slices.size()), 3, montage);
+  WritePng8(path, g.width(), g.height() * static_cast<int>(p.sky.slices.size()), 3, montage);
 }
 
 void WritePoints(const Scene& scene, const PointsOptions& o, const fs::path& path) {

@@ -19,6 +19,7 @@
 #include "spectrum/grid.h"
 #include "spectrum/xyz.h"
 #include "transport/path_tracer.h"
+#include "transport/sky_method.h"
 #include "transport/sky_render.h"
 
 namespace skybake {
@@ -62,6 +63,7 @@ Scene LoadScene(const SceneOptions& options, const ProgressFn& progress);
 
 struct RenderOptions {
   std::string method = "path";
+  SkyMethodOptions method_options;  // deterministic methods
   std::string mapping = "equirectangular";
   std::string size = "64x32";
   std::vector<double> sun_zenith_deg;
@@ -74,6 +76,7 @@ struct RenderOptions {
 
 struct RenderProducts {
   SkyRenderSettings settings;
+  std::string method_description;  // deterministic methods: their resolved settings (YAML)
   SkyRenderResult sky;
 };
 

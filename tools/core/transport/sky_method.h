@@ -1,0 +1,54 @@
+// The deterministic sky methods of sky-render part 2 behind one interface, so that they render
+// the same products as the path tracer and can be compared with it (docs/sky-methods.md):
+//   single     ray-marched single scattering (+ the ground's first reflection)
+//   orders     successive orders of scattering on precomputed tables (Bruneton & Neyret 2008)
+//   ms-approx  single scattering + Hillaire (2020)'s multiple-scattering approximation
+//   analytic   the Cloud Party approximation (constant-density single scattering)
+// A method is built once per atmosphere (it may precompute tables) and then evaluated for any
+// observer altitude, sun zenith and list of view directions.
+#pragma once
+
+#include <array>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "atmosphere/model.h"
+#include "io/progress.h"
+
+namespace skybake {
+
+// Knobs common to the methods; each method documents which it reads. `quality` selects a
+// preset (low/medium/high) that the explicit numbers override when > 0.
+struct SkyMethodOptions {
+  std::string quality = "medium";
+  int view_steps = 0;        // quadrature points along a view ray
+  int orders = 0;            // highest scattering order (orders: stop earlier if converged)
+  double order_tolerance = 0.0;  // orders: stop when an order adds less than this fraction
+  std::map<std::string, int> table_size;  // orders: named table resolutions (docs/sky-methods.md)
+};
+
+class SkyMethod {
+ public:
+  virtual ~SkyMethod() = default;
+  virtual std::string Name() const = 0;
+  // The resolved settings, for provenance (YAML text).
+  virtual std::string Describe() const = 0;
+  // Spectral radiance (W m^-2 sr^-1 nm^-1) at the model's grid wavelengths seen from
+  // `observer_altitude_m` along unit directions `dirs` (local frame: +z zenith, the sun in the
+  // x-z plane at zenith angle `sun_zenith_rad`, x > 0): out[d * n_wl + wl]. The sun disk itself
+  // is excluded, as in the path tracer. Const and thread-safe.
+  virtual void Radiance(double observer_altitude_m, double sun_zenith_rad,
+                        const std::vector<std::array<double, 3>>& dirs, std::vector<double>* out) const = 0;
+};
+
+// Builds a method by name ("single", "orders", "ms-approx", "analytic"); UsageError for an
+// unknown name or quality. May precompute (progress reported).
+std::unique_ptr<SkyMethod> MakeSkyMethod(const std::string& name, const AtmosphereModel& model,
+                                         const SkyMethodOptions& options, const ProgressFn& progress);
+
+// The names MakeSkyMethod knows (for --help and errors).
+std::vector<std::string> SkyMethodNames();
+
+}  // namespace skybake

@@ -1,0 +1,99 @@
+// sky-render edges: one render per atmosphere (docs/sky-render.md, docs/pipeline.md).
+//
+//   outputs/<atm>/components/render.yaml   canonical render component (written here)
+//   outputs/<atm>/sky.exr, sky.png         sky-render render (+ preview)
+//
+// The edge depends on the render component, the atmosphere's profiles.exr, the Mie tables of
+// its particle types and the tool; data tables (sun spectrum, albedo, ozone cross-section,
+// CMFs, the OCIO config) come through the depfile. Settings come from pipeline.yaml's `sky`
+// section:
+//   sky:
+//     method: path                 # the only method until sky-render part 2
+//     mapping: equirectangular     # or fisheye
+//     size: 32x16
+//     sun_zenith_deg: [30, 70, 85, 90, 94]
+//     target_error: 0.05           # relative standard error of Y per texel
+//     preview: true
+#include <fmt/format.h>
+
+#include <set>
+
+#include "atmosphere/spec.h"
+#include "paths.h"
+#include "stage.h"
+
+namespace skybake {
+
+namespace {
+
+class SkyRenderStage : public Stage {
+ public:
+  std::string tool() const override { return "sky-render"; }
+
+  void ParseConfig(YamlMap& root) override {
+    std::optional<YamlMap> sky = root.OptionalMap("sky");
+    if (!sky) return;
+    method_ = sky->ChoiceOr("method", {"path"}, method_);
+    mapping_ = sky->ChoiceOr("mapping", {"equirectangular", "fisheye"}, mapping_);
+    if (std::optional<std::string> size = sky->OptionalString("size", "WxH, e.g. 32x16")) {
+      int w = 0, h = 0;
+      if (std::sscanf(size->c_str(), "%dx%d", &w, &h) != 2 || w < 2 || h < 2 || w > 8192 || h > 8192) {
+        sky->Get("size")->ErrorExpected("WxH with sides from 2 to 8192, e.g. 32x16");
+      } else {
+        size_ = *size;
+      }
+    }
+    if (sky->Has("sun_zenith_deg")) sun_zenith_deg_ = sky->NumberList("sun_zenith_deg", NumberSpec::Range(0, 180, "degrees"));
+    target_error_ = sky->NumberOr("target_error", NumberSpec::Range(1e-4, 1.0, ""), target_error_);
+    preview_ = sky->BoolOr("preview", preview_);
+    sky->Finish();
+  }
+
+  void EmitRules(GenContext& ctx) const override {
+    const std::string pool = ctx.pipeline().pools.count("render") ? "render" : "";
+    ctx.ninja().Rule(ToolRule(ctx, "sky_render", tool(), pool));
+  }
+
+  void EmitEdges(GenContext& ctx) const override {
+    const auto& wl = ctx.pipeline().wavelengths;
+    std::string zeniths;
+    for (double z : sun_zenith_deg_) zeniths += (zeniths.empty() ? "" : ",") + FormatExact(z);
+    for (const PipelineAtmosphere& a : ctx.pipeline().atmospheres) {
+      const std::filesystem::path comp_rel = paths::RenderComponent(a.name);
+      ctx.WriteComponent(comp_rel, CanonicalRenderYaml(a.spec, (ctx.pipeline().out_dir / comp_rel).parent_path()));
+      NinjaBuild b;
+      b.outputs = {paths::Sky(a.name).generic_string()};
+      if (preview_) b.implicit_outputs = {paths::SkyPreview(a.name).generic_string()};
+      b.rule = "sky_render";
+      b.inputs = {comp_rel.generic_string()};
+      b.implicit_inputs = {ctx.ToolPath(tool()), paths::Profiles(a.name).generic_string()};
+      std::set<std::string> particles;
+      for (const AerosolLayerSpec& layer : a.spec.aerosols) {
+        if (layer.particle) particles.insert(layer.particle->stem().string());
+      }
+      for (const std::string& p : particles) b.implicit_inputs.push_back(paths::MieTable(p).generic_string());
+      std::string args = fmt::format(
+          "render --method {} --profiles {} --mie-dir mie --wavelengths {}:{}:{} --mapping {} --size {} "
+          "--sun-zenith-deg {} --target-error {}",
+          method_, paths::Profiles(a.name).generic_string(), FormatExact(wl.min_nm), FormatExact(wl.max_nm),
+          FormatExact(wl.step_nm), mapping_, size_, zeniths, FormatExact(target_error_));
+      if (preview_) args += " --preview " + paths::SkyPreview(a.name).generic_string();
+      b.variables = {{"args", args}};
+      ctx.Build(tool(), b);
+    }
+  }
+
+ private:
+  std::string method_ = "path";
+  std::string mapping_ = "equirectangular";
+  std::string size_ = "32x16";
+  std::vector<double> sun_zenith_deg_ = {30, 70, 85, 90, 94};
+  double target_error_ = 0.05;
+  bool preview_ = true;
+};
+
+}  // namespace
+
+std::unique_ptr<Stage> MakeSkyRenderStage() { return std::make_unique<SkyRenderStage>(); }
+
+}  // namespace skybake
