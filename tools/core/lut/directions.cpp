@@ -104,4 +104,11 @@ class StaticMapping : public SkyMapping {
 
 std::unique_ptr<SkyMapping> MakeStaticMapping(const DirectionGrid& grid) { return std::make_unique<StaticMapping>(grid); }
 
+std::unique_ptr<SkyMapping> MakeSkyMapping(const std::string& name, int width, int height) {
+  if (std::optional<DirectionMapping> m = ParseDirectionMapping(name)) return MakeStaticMapping(DirectionGrid{*m, width, height});
+  return nullptr;
+}
+
+std::vector<std::string> SkyMappingNames() { return {"equirectangular", "fisheye"}; }
+
 }  // namespace skybake

@@ -20,6 +20,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace skybake {
 
@@ -67,5 +68,10 @@ class SkyMapping {
 
 // The sun-independent mappings as SkyMapping.
 std::unique_ptr<SkyMapping> MakeStaticMapping(const DirectionGrid& grid);
+
+// Every mapping by name ("equirectangular", "fisheye", and those registered by lut-pack such as
+// "gt7"), for sky-render's --mapping; nullptr for an unknown name.
+std::unique_ptr<SkyMapping> MakeSkyMapping(const std::string& name, int width, int height);
+std::vector<std::string> SkyMappingNames();
 
 }  // namespace skybake

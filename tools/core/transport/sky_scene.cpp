@@ -139,13 +139,16 @@ Scene LoadScene(const SceneOptions& o, const ProgressFn& progress) {
 
 RenderProducts RenderProductsOf(const Scene& scene, const RenderOptions& o, const ProgressFn& progress) {
   RenderProducts p;
-  std::optional<DirectionMapping> mapping = ParseDirectionMapping(o.mapping);
-  if (!mapping) throw UsageError("--mapping: expected equirectangular or fisheye, got '" + o.mapping + "'");
   int w = 0, h = 0;
   if (std::sscanf(o.size.c_str(), "%dx%d", &w, &h) != 2 || w < 2 || h < 2 || w > 8192 || h > 8192) {
     throw UsageError("--size: expected WxH (2 to 8192), got '" + o.size + "'");
   }
-  p.settings.mapping = MakeStaticMapping(DirectionGrid{*mapping, w, h});
+  p.settings.mapping = MakeSkyMapping(o.mapping, w, h);
+  if (!p.settings.mapping) {
+    std::string names;
+    for (const std::string& n : SkyMappingNames()) names += (names.empty() ? "" : ", ") + n;
+    throw UsageError("--mapping: expected one of " + names + ", got '" + o.mapping + "'");
+  }
   for (double z : o.sun_zenith_deg) {
     if (!(z >= 0.0 && z <= 180.0)) throw UsageError(fmt::format("--sun-zenith-deg: {} is outside 0-180", z));
   }
