@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include "lut/gt7_mapping.h"
+
 namespace skybake {
 
 namespace {
@@ -106,9 +108,10 @@ std::unique_ptr<SkyMapping> MakeStaticMapping(const DirectionGrid& grid) { retur
 
 std::unique_ptr<SkyMapping> MakeSkyMapping(const std::string& name, int width, int height) {
   if (std::optional<DirectionMapping> m = ParseDirectionMapping(name)) return MakeStaticMapping(DirectionGrid{*m, width, height});
+  if (name == "gt7") return std::make_unique<gt7::Gt7SkyMapping>(width, height);  // lut-pack (lut/gt7_mapping.h)
   return nullptr;
 }
 
-std::vector<std::string> SkyMappingNames() { return {"equirectangular", "fisheye"}; }
+std::vector<std::string> SkyMappingNames() { return {"equirectangular", "fisheye", "gt7"}; }
 
 }  // namespace skybake
