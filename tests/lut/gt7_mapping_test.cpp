@@ -40,8 +40,8 @@ double Angle(const std::array<double, 3>& a, const std::array<double, 3>& b) {
 }
 
 const std::vector<double>& SunZenithsDeg() {
-  static const std::vector<double> z = {0.0,  1e-7, 10.0, 35.2, 45.0, 60.0, 80.0, 86.5, 87.0 - 1e-9, 87.0,
-                                        87.0 + 1e-9, 87.5, 89.9, 90.0, 90.1, 95.0, 99.9, 100.0};
+  static const std::vector<double> z = {0.0,  1e-7, 10.0, 35.2, 45.0, 60.0, 74.5, 75.0 - 1e-9, 75.0, 75.0 + 1e-9,
+                                        80.0, 87.0, 89.9, 90.0, 90.1, 95.0, 99.9, 100.0};
   return z;
 }
 
@@ -102,13 +102,16 @@ TEST(Gt7Time, SliceCoordinateIsTheInverse) {
 }
 
 TEST(Gt7Time, ReducedMappingsAndNames) {
-  EXPECT_EQ(TimeMapping::ParseName("gt7"), (std::pair<int, int>{48, 16}));
-  EXPECT_EQ(TimeMapping::ParseName("gt7:3+2"), (std::pair<int, int>{3, 2}));
+  EXPECT_EQ(TimeMapping::ParseName("gt7"), (TimeMappingKind{48, 16, 1.0}));
+  EXPECT_EQ(TimeMapping::ParseName("gt7-quadratic"), (TimeMappingKind{48, 16, 2.0}));
+  EXPECT_EQ(TimeMapping::ParseName("gt7:3+2"), (TimeMappingKind{3, 2, 1.0}));
+  EXPECT_EQ(TimeMapping::ParseName("gt7-quadratic:4+3"), (TimeMappingKind{4, 3, 2.0}));
   EXPECT_FALSE(TimeMapping::ParseName("gt7:1+2"));
   EXPECT_FALSE(TimeMapping::ParseName("gt7:3+2x"));
   EXPECT_FALSE(TimeMapping::ParseName("gt7:03+2"));
+  EXPECT_FALSE(TimeMapping::ParseName("gt7:"));
   EXPECT_FALSE(TimeMapping::ParseName("gt8"));
-  const TimeMapping t = TimeMapping::ForPlanet(6371e3, 100e3, 0.0, 3, 2);
+  const TimeMapping t = TimeMapping::ForPlanet(6371e3, 100e3, 0.0, {3, 2, 1.0});
   const std::vector<double> z = t.SliceZenithDeg();
   ASSERT_EQ(z.size(), 5u);
   EXPECT_EQ(z[0], 0.0);
@@ -116,9 +119,35 @@ TEST(Gt7Time, ReducedMappingsAndNames) {
   EXPECT_EQ(z[3], 90.0);
   EXPECT_NEAR(z[4], 100.0, 1e-12);
   EXPECT_THROW(TimeMapping::ForPlanet(6371e3, 100e3, 100e3), skybake::UsageError);
-  EXPECT_THROW(TimeMapping::ForPlanet(6371e3, 100e3, 0.0, 1, 16), skybake::UsageError);
+  EXPECT_THROW(TimeMapping::ForPlanet(6371e3, 100e3, 0.0, {1, 16, 1.0}), skybake::UsageError);
+  EXPECT_THROW(TimeMapping::FromName("gt9", 6371e3, 100e3, 0.0), skybake::UsageError);
   // A raised observer sees a shorter vertical path: d_min = top - altitude.
   EXPECT_NEAR(TimeMapping::ForPlanet(6371e3, 100e3, 2000.0).DMinM(), 98e3, 1e-6);
+}
+
+TEST(Gt7Time, QuadraticVariantSpendsSlicesOnHighSun) {
+  // skybake's variant: d_i = lerp(d_min, d_max, (i/47)^2); the same ends, the same lower region,
+  // the inverse still exact, the first step 5.6 deg instead of 35.2 deg.
+  const TimeMapping t = TimeMapping::FromName("gt7-quadratic", 6371e3, 100e3, 0.0);
+  const TimeMapping talk = Earth();
+  const std::vector<double> z = t.SliceZenithDeg(), zt = talk.SliceZenithDeg();
+  EXPECT_EQ(z[0], 0.0);
+  EXPECT_EQ(z[47], 90.0);
+  for (int i = 48; i < 64; ++i) EXPECT_EQ(z[i], zt[i]);
+  for (int i = 0; i < 48; ++i) {
+    const double d = t.DMinM() + (t.DMaxM() - t.DMinM()) * std::pow(i / 47.0, 2);
+    EXPECT_NEAR(PathByQuadratic(t.observer_radius_m, t.top_radius_m, z[i] * kDeg), d, 1e-6 * d) << i;
+    EXPECT_NEAR(t.SliceCoordinate(z[i] * kDeg), i, 1e-9) << i;
+    if (i > 0) {
+      EXPECT_GT(z[i], z[i - 1]);
+    }
+  }
+  EXPECT_NEAR(z[1], 5.6, 0.1);
+  EXPECT_NEAR(zt[1], 35.25, 0.01);
+  EXPECT_LT(z[47] - z[46], 0.5);  // still dense at the horizon (0.2 deg for the talk's)
+  std::printf("gt7-quadratic slices (deg):");
+  for (int i = 0; i < 64; ++i) std::printf("%s%.4f", i % 8 ? " " : "\n  ", z[i]);
+  std::printf("\n");
 }
 
 // ------------------------------------------------------------------------------------- sphere
@@ -171,22 +200,24 @@ TEST(Gt7Sphere, WarpsAreMonotonicWithTheirInverses) {
 }
 
 TEST(Gt7Sphere, SunAlignedGeometry) {
-  const SphereMapping m;
-  for (double zd : {0.0, 20.0, 60.0, 85.0, 87.0}) {
+  // The sun-aligned family at any sun zenith angle below 90 deg (also above the threshold: the
+  // decoder reads the slice that straddles it with this family).
+  auto SA = [](double u, double v, double ts) { return SphereMapping::DirectionIn(SphereFamily::kSunAligned, u, v, ts); };
+    for (double zd : {0.0, 20.0, 60.0, 75.0, 85.0, 87.0}) {
     const double ts = zd * kDeg;
     const std::array<double, 3> sun = {std::sin(ts), 0.0, std::cos(ts)};
     for (double u : {0.0, 0.1, 0.5, 0.77, 1.0}) {
       // v = 0 is the sun, v = 1 the anti-sun point, v = 0.8 the horizon for every azimuth.
-      EXPECT_LT(Angle(m.Direction(u, 0.0, ts), sun), 1e-12);
-      EXPECT_NEAR(Angle(m.Direction(u, 1.0, ts), sun), kPi, 1e-7);
-      EXPECT_NEAR(m.Direction(u, 0.8, ts)[2], 0.0, 1e-12) << zd << " " << u;
-      EXPECT_GT(m.Direction(u, 0.8 - 1e-6, ts)[2], 0.0);
-      EXPECT_LT(m.Direction(u, 0.8 + 1e-6, ts)[2], 0.0);
+      EXPECT_LT(Angle(SA(u, 0.0, ts), sun), 1e-12);
+      EXPECT_NEAR(Angle(SA(u, 1.0, ts), sun), kPi, 1e-7);
+      EXPECT_NEAR(SA(u, 0.8, ts)[2], 0.0, 1e-12) << zd << " " << u;
+      EXPECT_GT(SA(u, 0.8 - 1e-6, ts)[2], 0.0);
+      EXPECT_LT(SA(u, 0.8 + 1e-6, ts)[2], 0.0);
       // u covers the half-space y >= 0.
-      EXPECT_GE(m.Direction(u, 0.4, ts)[1], -1e-15);
+      EXPECT_GE(SA(u, 0.4, ts)[1], -1e-15);
     }
     // u = 0 looks from the sun straight down: the sun's vertical plane, towards the sun's azimuth.
-    const std::array<double, 3> below = m.Direction(0.0, 0.7, ts);
+    const std::array<double, 3> below = SA(0.0, 0.7, ts);
     EXPECT_NEAR(below[1], 0.0, 1e-15);
     EXPECT_GT(below[0], 0.0);
     // u = 1 goes from the sun over the zenith: edge = 90 deg + theta_s.
@@ -197,7 +228,7 @@ TEST(Gt7Sphere, SunAlignedGeometry) {
 
 TEST(Gt7Sphere, LatLongGeometry) {
   const SphereMapping m;
-  for (double zd : {87.5, 89.0, 90.0, 95.0, 100.0}) {
+  for (double zd : {75.5, 87.5, 89.0, 90.0, 95.0, 100.0}) {
     const double ts = zd * kDeg, K = std::min(0.5, ts / kPi);
     // Row v = K is the view zenith angle K pi (the sun's own for theta_s <= 90 deg).
     for (double u : {0.0, 0.3, 1.0}) EXPECT_NEAR(std::acos(m.Direction(u, K, ts)[2]), K * kPi, 1e-9);
@@ -219,7 +250,7 @@ TEST(Gt7Sphere, UvToDirectionToUvWithin1e5TexelEverywhere) {
   std::vector<double> vs, us;
   for (int i = 1; i < 400; ++i) vs.push_back(i / 400.0);
   for (double e : {1e-3, 1e-5, 1e-7, 1e-9}) {
-    for (double c : {0.5, 0.8, 87.0 / 180.0, 0.49, 0.5}) {
+    for (double c : {0.5, 0.8, 75.0 / 180.0, 87.0 / 180.0, 0.49, 0.5}) {
       vs.push_back(c - e);
       vs.push_back(c + e);
     }
@@ -287,7 +318,7 @@ TEST(Gt7Sphere, EachFamilyIsContinuousInTheSunAngleUpToTheThreshold) {
   }
   EXPECT_EQ(m.FamilyFor(thr), SphereFamily::kSunAligned);
   EXPECT_EQ(m.FamilyFor(std::nextafter(thr, 10.0)), SphereFamily::kLatLong);
-  EXPECT_NEAR(thr, 87.0 * kDeg, 1e-15);
+  EXPECT_NEAR(thr, 75.0 * kDeg, 1e-15);
 }
 
 TEST(Gt7Sphere, SkyMappingFactoryAndTexels) {

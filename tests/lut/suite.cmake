@@ -1,1 +1,1 @@
-skybake_add_test_suite(NAME lut DEPS skybake_lut skybake_io TBB::tbb)
+skybake_add_test_suite(NAME lut DEPS skybake_lut skybake_transport skybake_atmosphere skybake_optics skybake_color skybake_spectrum skybake_io TBB::tbb)

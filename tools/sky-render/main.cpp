@@ -3,7 +3,7 @@
 //
 //   sky-render render ATMOSPHERE.yaml -o sky.exr [--profiles profiles.exr] [--mie-dir outputs/mie]
 //              [--method path] [--mapping equirectangular|fisheye] [--size 64x32]
-//              [--sun-zenith-deg 30,70,85,90,94] [--target-error 0.01] [--preview sky.png] ...
+//              [--sun-zenith-deg 30,70,85,90,94 | --time-mapping gt7] [--target-error 0.01] [--preview sky.png] ...
 //   sky-render points ATMOSPHERE.yaml --geometry in.csv -o out.csv [--wavelengths-out 440,550,680]
 #include <filesystem>
 #include <fstream>
@@ -72,10 +72,14 @@ int main(int argc, char** argv) {
   render->add_option("--method", ro.method, "Rendering method: path (the Monte-Carlo reference), single, orders, ms-approx, analytic")
       ->default_val("path");
   render->add_option("--quality", ro.method_options.quality, "Deterministic methods: low, medium or high")->default_val("medium");
-  render->add_option("--mapping", ro.mapping, "Direction mapping: equirectangular or fisheye")->default_val("equirectangular");
+  render->add_option("--mapping", ro.mapping, "Direction mapping: equirectangular, fisheye or gt7 (lut-pack's, docs/lut-pack.md)")->default_val("equirectangular");
   render->add_option("--size", ro.size, "Image size WxH")->default_val("64x32");
-  render->add_option("--sun-zenith-deg", ro.sun_zenith_deg, "Sun zenith angles (deg), comma separated")
+  CLI::Option* sza = render->add_option("--sun-zenith-deg", ro.sun_zenith_deg, "Sun zenith angles (deg), comma separated")
       ->delimiter(',')->default_str("30,70,85,90,94");
+  render->add_option("--time-mapping", ro.time_mapping,
+                     "Render the sun angles of the GT7 time mapping instead: gt7 (48 + 16 slices) or gt7:<upper>+<lower> "
+                     "(docs/lut-pack.md)")
+      ->excludes(sza);
   render->add_option("--observer-altitude-m", ro.observer_altitude_m, "Override the atmosphere's observer altitude (m)");
   render->add_option("--preview", ro.preview, "Also write a PNG preview (one row per sun angle, through the OCIO view)");
   render->add_option("--display", ro.display, "Preview display: sRGB, Rec.1886 Rec.709 or Rec.2100-PQ")->default_val("sRGB");
@@ -98,7 +102,7 @@ int main(int argc, char** argv) {
       RenderProducts p = RenderProductsOf(s, ro, cli.Progress());
       WriteRender(s, ro, p, output, cli.name());
       if (!ro.preview.empty()) WriteRenderPreview(s, ro, p, ro.preview);
-      cli.Info(fmt::format("{} sun angles, {} paths", ro.sun_zenith_deg.size(), p.sky.total_paths));
+      cli.Info(fmt::format("{} sun angles, {} paths", p.sky.slices.size(), p.sky.total_paths));
     } else {
       WritePoints(s, po, output);
     }

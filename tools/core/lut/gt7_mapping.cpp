@@ -24,22 +24,34 @@ double Clamp01(double x) { return std::clamp(x, 0.0, 1.0); }
 
 // ------------------------------------------------------------------------------------- time
 
-TimeMapping TimeMapping::ForPlanet(double planet_radius_m, double top_m, double observer_altitude_m, int upper,
-                                   int lower) {
+TimeMapping TimeMapping::ForPlanet(double planet_radius_m, double top_m, double observer_altitude_m,
+                                   const TimeMappingKind& kind) {
   if (!(planet_radius_m > 0.0) || !(top_m > 0.0) || !(observer_altitude_m >= 0.0) || !(observer_altitude_m < top_m)) {
     throw UsageError(fmt::format("gt7 time mapping: needs 0 <= observer altitude ({} m) < top of the atmosphere ({} m) "
                                  "and a positive planet radius ({} m)",
                                  observer_altitude_m, top_m, planet_radius_m));
   }
-  if (upper < 2 || lower < 2) {
-    throw UsageError(fmt::format("gt7 time mapping: needs at least 2 upper and 2 lower slices, got {} + {}", upper, lower));
+  if (kind.upper < 2 || kind.lower < 2 || !(kind.upper_power > 0.0)) {
+    throw UsageError(fmt::format("gt7 time mapping: needs at least 2 upper and 2 lower slices and a positive exponent, "
+                                 "got {} + {}, p = {}",
+                                 kind.upper, kind.lower, kind.upper_power));
   }
   TimeMapping t;
   t.observer_radius_m = planet_radius_m + observer_altitude_m;
   t.top_radius_m = planet_radius_m + top_m;
-  t.upper_slices = upper;
-  t.lower_slices = lower;
+  t.upper_slices = kind.upper;
+  t.lower_slices = kind.lower;
+  t.upper_power = kind.upper_power;
   return t;
+}
+
+TimeMapping TimeMapping::FromName(const std::string& name, double planet_radius_m, double top_m, double observer_altitude_m) {
+  const std::optional<TimeMappingKind> k = ParseName(name);
+  if (!k) {
+    throw UsageError("time mapping: expected gt7 or gt7-quadratic, optionally with :<upper>+<lower> slices (e.g. gt7:3+2), "
+                     "got '" + name + "'");
+  }
+  return ForPlanet(planet_radius_m, top_m, observer_altitude_m, *k);
 }
 
 double TimeMapping::DMinM() const { return top_radius_m - observer_radius_m; }
@@ -63,7 +75,7 @@ double TimeMapping::SliceZenithRad(int i) const {
   if (i < upper_slices) {
     if (i == 0) return 0.0;
     if (i == upper_slices - 1) return kPi / 2.0;
-    const double d = DMinM() + (DMaxM() - DMinM()) * i / (upper_slices - 1);
+    const double d = DMinM() + (DMaxM() - DMinM()) * std::pow(static_cast<double>(i) / (upper_slices - 1), upper_power);
     const double r = observer_radius_m, R = top_radius_m;
     const double c = ((R - r) * (R + r) - d * d) / (2.0 * r * d);
     return std::acos(std::clamp(c, -1.0, 1.0));
@@ -81,7 +93,8 @@ std::vector<double> TimeMapping::SliceZenithDeg() const {
 double TimeMapping::SliceCoordinate(double zenith_rad) const {
   if (!(zenith_rad > 0.0)) return 0.0;
   if (zenith_rad <= kPi / 2.0) {
-    const double s = (upper_slices - 1) * (PathToBoundaryM(zenith_rad) - DMinM()) / (DMaxM() - DMinM());
+    const double x = std::max(0.0, (PathToBoundaryM(zenith_rad) - DMinM()) / (DMaxM() - DMinM()));
+    const double s = (upper_slices - 1) * (upper_power == 1.0 ? x : std::pow(x, 1.0 / upper_power));
     return std::clamp(s, 0.0, static_cast<double>(upper_slices - 1));
   }
   const double f = std::sqrt((zenith_rad / kDeg - 90.0) / (kLowerEndZenithDeg - 90.0));
@@ -90,23 +103,40 @@ double TimeMapping::SliceCoordinate(double zenith_rad) const {
 
 std::string TimeMapping::Describe() const {
   return fmt::format(
-      "gt7 time mapping (gt7-sky-talk.txt, 'Adaptive Mapping of LUT (time component)'): {} slices; upper region "
-      "i = 0..{}: d_i = lerp(d_min, d_max, i/{}) with d_min = R - r = {} m, d_max = sqrt(R^2 - r^2) = {} m, "
+      "gt7 time mapping (gt7-sky-talk.txt, 'Adaptive Mapping of LUT (time component)'{}): {} slices; upper region "
+      "i = 0..{}: d_i = lerp(d_min, d_max, (i/{})^{}) with d_min = R - r = {} m, d_max = sqrt(R^2 - r^2) = {} m, "
       "cos(theta_i) = (R^2 - r^2 - d_i^2)/(2 r d_i); lower region i = {}..{}: theta_i = lerp(90, 100 deg, "
       "((i - {})/{})^2); observer radius r = {} m, top radius R = {} m",
-      slices(), upper_slices - 1, upper_slices - 1, FormatExact(DMinM()), FormatExact(DMaxM()), upper_slices,
-      slices() - 1, upper_slices, lower_slices - 1, FormatExact(observer_radius_m), FormatExact(top_radius_m));
+      upper_power == 1.0 ? "" : "; skybake's exponent p on the upper region", slices(), upper_slices - 1, upper_slices - 1,
+      FormatExact(upper_power), FormatExact(DMinM()), FormatExact(DMaxM()), upper_slices, slices() - 1, upper_slices,
+      lower_slices - 1, FormatExact(observer_radius_m), FormatExact(top_radius_m));
 }
 
-std::optional<std::pair<int, int>> TimeMapping::ParseName(const std::string& name) {
-  if (name == "gt7") return std::pair<int, int>{48, 16};
-  int u = 0, l = 0;
-  char tail = 0;
-  if (name.rfind("gt7:", 0) == 0 && std::sscanf(name.c_str() + 4, "%d+%d%c", &u, &l, &tail) == 2 && u >= 2 &&
-      l >= 2 && u + l <= 4096 && name == fmt::format("gt7:{}+{}", u, l)) {
-    return std::pair<int, int>{u, l};
+std::optional<TimeMappingKind> TimeMapping::ParseName(const std::string& name) {
+  TimeMappingKind k;
+  std::string base = name, counts;
+  if (const size_t colon = name.find(':'); colon != std::string::npos) {
+    base = name.substr(0, colon);
+    counts = name.substr(colon + 1);
   }
-  return std::nullopt;
+  if (base == "gt7") {
+    k.upper_power = 1.0;
+  } else if (base == "gt7-quadratic") {
+    k.upper_power = 2.0;
+  } else {
+    return std::nullopt;
+  }
+  if (name.find(':') != std::string::npos) {
+    int u = 0, l = 0;
+    char tail = 0;
+    if (std::sscanf(counts.c_str(), "%d+%d%c", &u, &l, &tail) != 2 || u < 2 || l < 2 || u + l > 4096 ||
+        counts != fmt::format("{}+{}", u, l)) {
+      return std::nullopt;
+    }
+    k.upper = u;
+    k.lower = l;
+  }
+  return k;
 }
 
 // ------------------------------------------------------------------------------------- sphere

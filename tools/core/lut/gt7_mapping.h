@@ -3,17 +3,21 @@
 // ../shared/design.md §6; docs/lut-pack.md has the derivations and the decisions).
 //
 // TIME (sun zenith angle theta_z per slice; 64 slices = 48 upper + 16 lower in GT7):
-//   upper region, i = 0 .. Nu-1:  d_i = lerp(d_min, d_max, i / (Nu - 1)), with d_min = R - r the
+//   upper region, i = 0 .. Nu-1:  d_i = lerp(d_min, d_max, (i / (Nu - 1))^p), with d_min = R - r the
 //     vertical and d_max = sqrt(R^2 - r^2) the horizontal distance from the observer (radius r)
 //     to the top of the atmosphere (radius R); theta_z is the zenith angle whose path to the
 //     boundary has length d_i:  R^2 = r^2 + d^2 + 2 r d cos(theta)  =>
 //     cos(theta_i) = ((R - r)(R + r) - d_i^2) / (2 r d_i)     (theta_0 = 0, theta_{Nu-1} = 90 deg)
+//     p = 1 is the talk's mapping ("gt7"); p = 2 ("gt7-quadratic") is skybake's variant: the talk's
+//     first upper step is 0 -> 35.2 deg, too wide to interpolate (docs/lut-pack.md measures 14 %
+//     RMS luminance error half-way), and p = 2 brings it to 5.6 deg while the last step near the
+//     horizon grows from 0.2 to 0.4 deg; it mirrors the lower region's square.
 //   lower region, i = Nu .. Nu+Nl-1:  theta_z = lerp(90 deg, 100 deg, ((i - Nu) / (Nl - 1))^2).
 //   The talk's two formulas both give 90 deg at their ends, so slices Nu-1 and Nu are the same
 //   sun position (rendered twice; see docs/lut-pack.md "Decisions"); zenith angles are
 //   non-decreasing in i and strictly increasing everywhere else.
-//   Inverse (continuous slice coordinate s in [0, N-1]): upper s = (Nu-1)(d(theta) - d_min) /
-//   (d_max - d_min) with d(theta) = sqrt(r^2 cos^2 + (R-r)(R+r)) - r cos; lower
+//   Inverse (continuous slice coordinate s in [0, N-1]): upper s = (Nu-1) ((d(theta) - d_min) /
+//   (d_max - d_min))^(1/p) with d(theta) = sqrt(r^2 cos^2 + (R-r)(R+r)) - r cos; lower
 //   s = Nu + (Nl-1) sqrt((theta - 90)/10); s is clamped to the last slice beyond 100 deg (what
 //   the decoder does below -10 deg elevation is in lut/decoder.h).
 //
@@ -41,10 +45,11 @@
 //     so that rows crowd at the sun's zenith angle (dv'/dv = 0 at v = K), i.e. at the horizon.
 //     The concept code adds pi/2 to phi for its own world frame; here phi is measured from the
 //     sun's azimuth directly (docs/lut-pack.md).
-//   threshold: sun elevation 3 deg (zenith 87 deg), the largest elevation the talk shows for the
-//     corner case ("Sun Elevation Angle 3 [deg] 1.5 [deg] 0 [deg]"); below it edge(0) -> 0 and the
-//     sun-aligned family squeezes the sky below the sun into a sliver (docs/lut-pack.md measures
-//     the decode error on both sides of it).
+//   threshold: sun elevation 15 deg (zenith 75 deg). The talk only shows the corner case at 3, 1.5
+//     and 0 deg; measured on the clear sky (docs/lut-pack.md, "Threshold"), the sun-aligned
+//     family's decode error between slices grows as the sun nears the horizon (edge(0) -> 0 squeezes
+//     the sky below the sun; 2.1 % RMS at 8 deg, 7.4 % at 3 deg elevation) while the lat-long
+//     family stays near 0.6 %, and the two cross at 12-15 deg elevation.
 // Every inverse (direction -> uv) is analytic.
 #pragma once
 
@@ -60,16 +65,27 @@ namespace skybake::gt7 {
 
 // ------------------------------------------------------------------------------------- time
 
+// The slice counts and the upper region's exponent: what a time mapping's name says.
+struct TimeMappingKind {
+  int upper = 48;            // Nu (GT7: 48)
+  int lower = 16;            // Nl (GT7: 16)
+  double upper_power = 1.0;  // p: 1 = the talk ("gt7"), 2 = "gt7-quadratic"
+  bool operator==(const TimeMappingKind&) const = default;
+};
+
 struct TimeMapping {
   double observer_radius_m = 6371e3;  // r: planet radius + observer altitude
   double top_radius_m = 6471e3;       // R: planet radius + top of the atmosphere
-  int upper_slices = 48;              // Nu (GT7: 48)
-  int lower_slices = 16;              // Nl (GT7: 16)
+  int upper_slices = 48;              // Nu
+  int lower_slices = 16;              // Nl
+  double upper_power = 1.0;           // p
   static constexpr double kLowerEndZenithDeg = 100.0;  // the last slice: sun 10 deg below the horizon
 
-  // Checks r < R and Nu, Nl >= 2; UsageError otherwise.
-  static TimeMapping ForPlanet(double planet_radius_m, double top_m, double observer_altitude_m, int upper = 48,
-                               int lower = 16);
+  // Checks r < R and Nu, Nl >= 2, p > 0; UsageError otherwise.
+  static TimeMapping ForPlanet(double planet_radius_m, double top_m, double observer_altitude_m,
+                              const TimeMappingKind& kind = {});
+  // ForPlanet with the kind of a name (ParseName); UsageError naming the accepted forms.
+  static TimeMapping FromName(const std::string& name, double planet_radius_m, double top_m, double observer_altitude_m);
   int slices() const { return upper_slices + lower_slices; }
   double DMinM() const;  // vertical distance to the boundary, R - r
   double DMaxM() const;  // horizontal distance to the boundary, sqrt(R^2 - r^2)
@@ -82,8 +98,10 @@ struct TimeMapping {
   double SliceCoordinate(double zenith_rad) const;
   // "gt7 time mapping: 48 upper slices ... r = ... m, R = ... m", for metadata and provenance.
   std::string Describe() const;
-  // "gt7" (48 + 16) or "gt7:<Nu>+<Nl>" (e.g. "gt7:3+2" for reduced bakes); nullopt if malformed.
-  static std::optional<std::pair<int, int>> ParseName(const std::string& name);
+  TimeMappingKind kind() const { return {upper_slices, lower_slices, upper_power}; }
+  // "gt7" (the talk: 48 + 16, p = 1) or "gt7-quadratic" (p = 2), optionally with ":<Nu>+<Nl>"
+  // (e.g. "gt7:3+2" for reduced bakes); nullopt if malformed.
+  static std::optional<TimeMappingKind> ParseName(const std::string& name);
 };
 
 // ------------------------------------------------------------------------------------- sphere
@@ -91,7 +109,7 @@ struct TimeMapping {
 enum class SphereFamily { kSunAligned, kLatLong };
 const char* SphereFamilyName(SphereFamily f);
 
-inline constexpr double kDefaultThresholdElevationDeg = 3.0;
+inline constexpr double kDefaultThresholdElevationDeg = 15.0;
 
 // The concept code's nonlinear v transforms and their inverses (each monotonic on [0, 1]).
 double SunAlignedWarp(double v);     // v -> v'

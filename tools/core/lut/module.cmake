@@ -1,1 +1,1 @@
-skybake_add_core_module(NAME lut DEPS skybake_io)
+skybake_add_core_module(NAME lut DEPS skybake_color skybake_spectrum skybake_io TBB::tbb)

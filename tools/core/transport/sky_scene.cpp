@@ -18,6 +18,7 @@
 #include "io/png.h"
 #include "io/yaml.h"
 #include "lut/directions.h"
+#include "lut/gt7_mapping.h"
 #include "optics/mie_table.h"
 
 namespace fs = std::filesystem;
@@ -137,6 +138,11 @@ Scene LoadScene(const SceneOptions& o, const ProgressFn& progress) {
   return s;
 }
 
+static gt7::TimeMapping TimeMappingOf(const Scene& scene, const RenderOptions& o, double observer_altitude_m) {
+  if (!scene.spec.planet) throw InputError(FileLoc{scene.spec.file.string(), 0}, "--time-mapping needs the 'planet' section");
+  return gt7::TimeMapping::FromName(o.time_mapping, scene.spec.planet->radius_m, scene.spec.planet->top_m, observer_altitude_m);
+}
+
 RenderProducts RenderProductsOf(const Scene& scene, const RenderOptions& o, const ProgressFn& progress) {
   RenderProducts p;
   int w = 0, h = 0;
@@ -157,6 +163,7 @@ RenderProducts RenderProductsOf(const Scene& scene, const RenderOptions& o, cons
   if (p.settings.observer_altitude_m >= scene.model.altitude_m.back()) {
     throw UsageError("the observer must be inside the atmosphere");
   }
+  if (!o.time_mapping.empty()) p.settings.sun_zenith_deg = TimeMappingOf(scene, o, p.settings.observer_altitude_m).SliceZenithDeg();
   if (o.method == "path") {
     PathTracer tracer(scene.model, scene.xyz_weights, scene.tracer);
     p.sky = RenderSky(tracer, p.settings, progress);
@@ -173,6 +180,7 @@ void WriteRender(const Scene& scene, const RenderOptions& o, const RenderProduct
   Provenance prov;
   prov.tool = tool;
   prov.parameters = fmt::format("method: {}\nmapping: {}\nsize: {}\n", o.method, o.mapping, o.size) +
+                    (o.time_mapping.empty() ? "" : "time_mapping: " + o.time_mapping + "\n") +
                     p.method_description + scene.parameters;
   for (const fs::path& f : scene.files_read) prov.AddInput(f);
 
@@ -200,8 +208,19 @@ void WriteRender(const Scene& scene, const RenderOptions& o, const RenderProduct
     full.strings["skybake.mapping"] = g.Describe();
     full.doubles["skybake.sun_zenith_deg"] = sl.sun_zenith_deg;
     full.doubles["skybake.observer_altitude_m"] = p.settings.observer_altitude_m;
+    if (!o.time_mapping.empty()) {  // what lut-pack needs to rebuild the slice coordinate
+      const gt7::TimeMapping tm = TimeMappingOf(scene, o, p.settings.observer_altitude_m);
+      full.strings["skybake.time_mapping"] = o.time_mapping;
+      full.strings["skybake.time_mapping.description"] = tm.Describe();
+      full.doubles["skybake.time_mapping.observer_radius_m"] = tm.observer_radius_m;
+      full.doubles["skybake.time_mapping.top_radius_m"] = tm.top_radius_m;
+    }
     SetProvenance(full, prov);
-    parts.push_back({SliceName(sl.sun_zenith_deg), std::move(full)});
+    // Time-mapped renders name parts by slice index too: the GT7 mapping has 90 deg twice.
+    const std::string part_name =
+        o.time_mapping.empty() ? SliceName(sl.sun_zenith_deg)
+                               : fmt::format("sky.slice_{:02d}.sza_{:06.2f}", parts.size(), sl.sun_zenith_deg);
+    parts.push_back({part_name, std::move(full)});
   }
   // Transmittance table (wavelength x view zenith).
   {

@@ -67,6 +67,10 @@ struct RenderOptions {
   std::string mapping = "equirectangular";
   std::string size = "64x32";
   std::vector<double> sun_zenith_deg;
+  // "gt7", "gt7-quadratic" (optionally ":<upper>+<lower>"): render the slices of that GT7 time
+  // mapping for this atmosphere's planet and observer instead of sun_zenith_deg
+  // (lut/gt7_mapping.h; lut-pack, docs/lut-pack.md).
+  std::string time_mapping;
   double observer_altitude_m = -1.0;  // < 0: the atmosphere's
   std::string preview;
   std::string display = "sRGB";

@@ -1,0 +1,100 @@
+#include "outputs.h"
+
+#include <fmt/format.h>
+
+#include "color/color.h"
+#include "color/exr_color.h"
+#include "io/yaml.h"
+#include "lut/dds.h"
+
+namespace skybake::luttool {
+
+namespace {
+
+// R, G, B (decoded, physical units) + the packing error and the clamp flags of each texel.
+ExrImage InspectionImage(int width, int height, const lut::PackedTexture& t, const Provenance& prov) {
+  const ExrImage colour = MakeColorImage(width, height, t.decoded_rgb, ocio_names::kLinearRec2020);
+  ExrImage img;
+  img.Resize(width, height, {"R", "G", "B", "input_R", "input_G", "input_B", "clamp_flags"});
+  const size_t n = static_cast<size_t>(width) * height;
+  for (size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      img.pixels[i * 7 + c] = t.decoded_rgb[i * 3 + c];
+      img.pixels[i * 7 + 3 + c] = t.input_rgb[i * 3 + c];
+    }
+    img.pixels[i * 7 + 6] = t.clamp_flags[i];
+  }
+  img.chromaticities = colour.chromaticities;
+  img.strings = colour.strings;
+  img.strings["skybake.channels"] =
+      "R, G, B: the packed texels as a shader reads them, divided by the scale (physical units, Linear Rec.2020); "
+      "input_R/G/B: the values before packing; clamp_flags: 1 = a component above the format's largest value, "
+      "2 = a negative component (outside Rec.2020), 4 = a denormal component (bit OR)";
+  img.doubles["skybake.scale"] = t.scale;
+  SetProvenance(img, prov);
+  return img;
+}
+
+std::string Rows(const lut::LutSet& set) {
+  std::string rows;
+  for (const lut::SkyLutProduct& s : set.skies) rows += (rows.empty() ? "" : " ") + s.name;
+  return rows;
+}
+
+dds::Texture Dds(const lut::PackedTexture& t, bool volume) {
+  dds::Texture d;
+  d.width = static_cast<uint32_t>(t.width);
+  d.height = static_cast<uint32_t>(t.height);
+  d.depth = volume ? static_cast<uint32_t>(t.depth) : 0;
+  d.data = t.bytes;
+  return d;
+}
+
+}  // namespace
+
+std::map<std::string, std::string> EncodeLutSet(const lut::LutSet& set, const Provenance& prov) {
+  std::map<std::string, std::string> out;
+  for (const lut::SkyLutProduct& s : set.skies) {
+    const std::string base = "sky_" + s.name;
+    out[base + ".ktx2"] = ktx2::EncodeKtx2(lut::SkyKtx2(set, s, false, prov));
+    out[base + "_array.ktx2"] = ktx2::EncodeKtx2(lut::SkyKtx2(set, s, true, prov));
+    out[base + ".dds"] = dds::EncodeDds(Dds(s.sky, true));
+    ExrImage img = InspectionImage(s.sky.width, s.sky.height * s.sky.depth, s.sky, prov);
+    std::string zen;
+    for (double z : s.render->slice_zenith_deg) zen += (zen.empty() ? "" : " ") + FormatExact(z);
+    img.strings["skybake.layout"] = fmt::format("{} slices of {}x{} stacked top to bottom (slice k in rows {}k .. {}k + {})",
+                                                s.sky.depth, s.sky.width, s.sky.height, s.sky.height, s.sky.height,
+                                                s.sky.height - 1);
+    img.strings["skybake.slice_zenith_deg"] = zen;
+    img.strings["skybake.mapping"] = s.render->sphere.Describe();
+    img.strings["skybake.basis_sky"] = s.name;
+    out[base + ".exr"] = EncodeExr(img);
+  }
+  struct Other {
+    const char* name;
+    const lut::PackedTexture* t;
+    std::string quantity, axis;
+  };
+  const std::vector<Other> others = {
+      {"transmittance", &set.transmittance,
+       "transmittance from the observer to space for sunlight, per Linear Rec.2020 channel: [E0 T]_c / [E0]_c (1)",
+       "view zenith angle 0..180 deg, texel i at i deg: u = (i + 1/2)/181; rows: " + Rows(set)},
+      {"sun", &set.sun, "direct sun illuminance at normal incidence (lux, Linear Rec.2020), times skybake.scale",
+       "the sky LUT's slices: u = (s + 1/2)/N for slice coordinate s; rows: " + Rows(set)},
+      {"ambient", &set.ambient, "sky illuminance on a horizontal surface without the sun disk (lux, Linear Rec.2020), times skybake.scale",
+       "the sky LUT's slices: u = (s + 1/2)/N for slice coordinate s; rows: " + Rows(set)},
+  };
+  std::vector<ExrPart> parts;
+  for (const Other& o : others) {
+    out[std::string(o.name) + ".ktx2"] = ktx2::EncodeKtx2(lut::TableKtx2(set, *o.t, o.quantity, o.axis, prov));
+    out[std::string(o.name) + ".dds"] = dds::EncodeDds(Dds(*o.t, false));
+    ExrImage img = InspectionImage(o.t->width, o.t->height, *o.t, prov);
+    img.strings["skybake.quantity"] = o.quantity;
+    img.strings["skybake.axis_u"] = o.axis;
+    parts.push_back({o.name, std::move(img)});
+  }
+  out["other_luts.exr"] = EncodeExrParts(parts);
+  return out;
+}
+
+}  // namespace skybake::luttool

@@ -1,0 +1,22 @@
+// The files lut-pack writes for one set, encoded in memory (docs/lut-pack.md, "Outputs"):
+//   sky_<name>.ktx2        KTX2 3D texture W x H x N, B10G11R11_UFLOAT_PACK32
+//   sky_<name>_array.ktx2  KTX2 2D array, N layers, the same texels
+//   sky_<name>.dds         DDS volume, DXGI_FORMAT_R11G11B10_FLOAT
+//   sky_<name>.exr         inspection: the decoded texels (physical units), slices stacked
+//                          vertically, with the packing error and clamp flags per texel
+//   transmittance, sun, ambient .ktx2/.dds   one row per basis sky
+//   other_luts.exr         inspection of those three (one part each)
+#pragma once
+
+#include <map>
+#include <string>
+
+#include "io/exr.h"
+#include "lut/sky_lut.h"
+
+namespace skybake::luttool {
+
+// File name (in the output folder) -> bytes.
+std::map<std::string, std::string> EncodeLutSet(const lut::LutSet& set, const Provenance& provenance);
+
+}  // namespace skybake::luttool
