@@ -1,0 +1,104 @@
+// Scenes shared by the sky-method tests (method_*_test.cpp, stability_test.cpp): the repository's
+// clear and hazed atmospheres on a coarse wavelength grid (so the Mie tables are built in the
+// test in a few seconds), and a homogeneous shell with closed forms.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <numbers>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "atmosphere/mie_optics.h"
+#include "atmosphere/model_build.h"
+#include "optics/particle_type.h"
+#include "optics/polydisperse.h"
+#include "spectrum/cmf.h"
+#include "spectrum/xyz.h"
+#include "transport/path_tracer.h"
+
+namespace skybake::testing {
+
+inline constexpr double kPi = std::numbers::pi;
+inline constexpr double kDeg = kPi / 180.0;
+
+struct TestScene {
+  AtmosphereModel model;
+  std::vector<std::array<double, 3>> weights;  // CIE 1931 XYZ weights on the grid
+  // Y (cd/m^2) of a spectral radiance on the grid.
+  double Y(const double* L) const {
+    double y = 0.0;
+    for (size_t w = 0; w < weights.size(); ++w) y += weights[w][1] * L[w];
+    return y;
+  }
+};
+
+struct SceneOptions {
+  double aerosol_tau_550 = -1.0;  // < 0: the file's
+  AerosolPhase phase = AerosolPhase::kTabulated;
+  bool aerosols = true;
+};
+
+// atmospheres/<name>.yaml with its particle type, 100 m levels, 380-780 nm at 20 nm (21 samples).
+inline TestScene LoadTestScene(const std::string& name, const SceneOptions& o = {}) {
+  AtmosphereSpec spec = LoadAtmosphere(SKYBAKE_SOURCE_DIR "/atmospheres/" + name + ".yaml");
+  spec.grid = GridSpec{100.0};
+  if (o.aerosol_tau_550 >= 0.0) {
+    for (AerosolLayerSpec& a : spec.aerosols) a.scale->value = o.aerosol_tau_550;
+  }
+  VerticalProfiles prof = ComputeProfiles(spec);
+  const WavelengthGrid grid = WavelengthGrid::Uniform(380, 780, 20);
+  std::vector<AerosolOptics> aerosols;
+  if (o.aerosols) {
+    for (const AerosolLayerSpec& layer : spec.aerosols) {
+      mie::ParticleType type = mie::LoadParticleType(*layer.particle);
+      mie::MieBuildOptions mo;
+      mo.fits = o.phase != AerosolPhase::kTabulated;
+      auto table = std::make_shared<mie::MieTable>(mie::BuildMieTable(type, grid.wavelength_nm(), mo).table);
+      aerosols.push_back(AerosolOpticsFromMie(layer.name, table, grid, o.phase));
+    }
+  }
+  ModelOptions mopt;
+  mopt.aerosols = o.aerosols;
+  TestScene s;
+  s.model = BuildAtmosphereModel(spec, prof, grid, aerosols, mopt, nullptr);
+  XyzWeights w(grid, Cmf::LoadDefault(Observer::kCie1931_2deg));
+  for (size_t i = 0; i < grid.size(); ++i) s.weights.push_back({w.wx()[i], w.wy()[i], w.wz()[i]});
+  return s;
+}
+
+// A homogeneous shell R < r < R + H with per-wavelength scattering and absorption (m^-1), one
+// phase model, a constant ground albedo and a point-like sun of irradiance 1.
+inline AtmosphereModel Homogeneous(double R, double H, std::vector<double> sigma_s, std::vector<double> sigma_a,
+                                   std::shared_ptr<const PhaseModel> phase, double albedo, size_t levels = 2) {
+  AtmosphereModel m;
+  m.bottom_radius_m = R;
+  m.top_radius_m = R + H;
+  const size_t nw = sigma_s.size();
+  for (size_t i = 0; i < levels; ++i) m.altitude_m.push_back(H * static_cast<double>(i) / static_cast<double>(levels - 1));
+  for (size_t w = 0; w < nw; ++w) m.wavelength_nm.push_back(400.0 + 100.0 * static_cast<double>(w));
+  MediumComponent c;
+  c.name = "test";
+  c.phase = std::move(phase);
+  for (size_t i = 0; i < levels; ++i) {
+    for (size_t w = 0; w < nw; ++w) {
+      c.scattering.push_back(sigma_s[w]);
+      c.absorption.push_back(sigma_a[w]);
+    }
+  }
+  m.components.push_back(c);
+  m.ground_albedo.assign(nw, albedo);
+  m.sun.irradiance.assign(nw, 1.0);
+  m.sun.angular_radius_rad = 1e-4;
+  m.Finalize();
+  return m;
+}
+
+// The local-frame direction of view zenith theta and azimuth phi from the sun (deg).
+inline std::array<double, 3> Dir(double theta_deg, double phi_deg) {
+  const double t = theta_deg * kDeg, p = phi_deg * kDeg;
+  return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
+}
+
+}  // namespace skybake::testing
