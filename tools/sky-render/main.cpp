@@ -47,12 +47,16 @@ int main(int argc, char** argv) {
     sub->add_option("atmosphere", scene.atmosphere, "Atmosphere YAML (full, or its render component)")->required();
     sub->add_option("--profiles", scene.profiles, "profiles.exr from profile-import (default: computed from the atmosphere)");
     sub->add_option("--mie-dir", scene.mie_dir, "Folder with the Mie tables <particle>.exr of the aerosol layers");
-    sub->add_option("--wavelengths", scene.wavelengths, "Spectral grid min:max:step in nm")->default_val("360:830:5");
+    sub->add_option("--wavelengths", scene.wavelengths,
+                    "Spectral grid min:max:step in nm, or rgb (680/550/440 nm, Bruneton's colour rule; docs/sky-methods.md)")
+        ->default_val("360:830:5");
     sub->add_option("--observer", scene.observer, "Colour-matching functions: cie2006_2deg or cie1931_2deg")
         ->default_val("cie2006_2deg");
     sub->add_option("--aerosol-phase", scene.aerosol_phase, "Aerosol phase model: mie, hg, hg-moment, cornette-shanks, dual-lobe")
         ->default_val("mie");
     sub->add_flag("--no-ozone", scene.no_ozone, "Drop ozone absorption (a simplification to measure)");
+    sub->add_flag("--profiles-exponential", scene.profiles_exponential,
+                  "Exponential air and aerosol profiles and a tent of ozone with the measured columns (a simplification)");
     sub->add_option("--illumination", scene.illumination, "sun, or uniform (unit radiance from space: the white furnace)")
         ->default_val("sun");
     sub->add_option("--target-error", scene.target_error, "Target relative standard error of Y per estimate")

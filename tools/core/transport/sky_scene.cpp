@@ -10,6 +10,7 @@
 
 #include "atmosphere/mie_optics.h"
 #include "atmosphere/model_build.h"
+#include "atmosphere/simplify.h"
 #include "color/color.h"
 #include "color/exr_color.h"
 #include "io/csv.h"
@@ -20,6 +21,8 @@
 #include "lut/directions.h"
 #include "lut/gt7_mapping.h"
 #include "optics/mie_table.h"
+#include "spectrum/spectrum.h"
+#include "transport/rgb_color.h"
 
 namespace fs = std::filesystem;
 
@@ -47,15 +50,16 @@ std::string SliceName(double sza) { return fmt::format("sky.sza_{:06.2f}", sza);
 }  // namespace
 
 WavelengthGrid ParseWavelengthGrid(const std::string& text) {
+  if (text == "rgb") return WavelengthGrid::Rgb();
   std::vector<double> parts;
   std::stringstream ss(text);
   std::string item;
   while (std::getline(ss, item, ':')) {
     std::optional<double> v = ParseNumber(item);
-    if (!v) throw UsageError("--wavelengths: expected min:max:step in nm, got '" + text + "'");
+    if (!v) throw UsageError("--wavelengths: expected min:max:step in nm or rgb, got '" + text + "'");
     parts.push_back(*v);
   }
-  if (parts.size() != 3) throw UsageError("--wavelengths: expected min:max:step in nm, got '" + text + "'");
+  if (parts.size() != 3) throw UsageError("--wavelengths: expected min:max:step in nm or rgb, got '" + text + "'");
   try {
     return WavelengthGrid::Uniform(parts[0], parts[1], parts[2]);
   } catch (const InputError& e) {
@@ -85,6 +89,7 @@ Scene LoadScene(const SceneOptions& o, const ProgressFn& progress) {
     s.profiles = ProfilesFromTable(ImageToTable(ReadExr(o.profiles), o.profiles), o.profiles);
     s.files_read.push_back(o.profiles);
   }
+  if (o.profiles_exponential) s.profiles = AnalyticProfiles(s.profiles);
 
   // Aerosol optics from the Mie tables: <mie_dir>/<particle file stem>.exr.
   std::vector<AerosolOptics> aerosols;
@@ -109,10 +114,16 @@ Scene LoadScene(const SceneOptions& o, const ProgressFn& progress) {
   // Colour weights.
   const Cmf cmf = Cmf::LoadDefault(s.observer);
   s.files_read.push_back(cmf.path());
-  s.xyz = std::make_shared<XyzWeights>(s.grid, cmf);
-  for (size_t i = 0; i < s.grid.size(); ++i) s.xyz_weights.push_back({s.xyz->wx()[i], s.xyz->wy()[i], s.xyz->wz()[i]});
   s.ocio_config = ColorConfig::ResolvePath(o.ocio_config);
   s.files_read.push_back(s.ocio_config);
+  if (s.grid.is_spectral()) {
+    s.xyz = std::make_shared<XyzWeights>(s.grid, cmf);
+    for (size_t i = 0; i < s.grid.size(); ++i) s.xyz_weights.push_back({s.xyz->wx()[i], s.xyz->wy()[i], s.xyz->wz()[i]});
+  } else {
+    // The RGB grid: Bruneton's sky radiance-to-colour rule (transport/rgb_color.h).
+    s.xyz_weights = RgbGridXyzWeights(cmf, LoadSpectrumColumn(s.spec.sun->spectrum.file, s.spec.sun->spectrum.value_column),
+                                      ColorConfig::Load(s.ocio_config));
+  }
 
   s.tracer.illumination = o.illumination == "uniform" ? Illumination::kUniform : Illumination::kSun;
   s.tracer.target_relative_error = o.target_error;
@@ -127,6 +138,7 @@ Scene LoadScene(const SceneOptions& o, const ProgressFn& progress) {
   y << YAML::Key << "observer" << YAML::Value << ObserverName(s.observer);
   y << YAML::Key << "aerosol_phase" << YAML::Value << AerosolPhaseName(phase);
   y << YAML::Key << "ozone" << YAML::Value << (o.no_ozone ? "off" : "on");
+  y << YAML::Key << "profiles" << YAML::Value << (o.profiles_exponential ? "exponential" : "measured");
   y << YAML::Key << "illumination" << YAML::Value << o.illumination;
   y << YAML::Key << "target_relative_error" << YAML::Value << FormatExact(o.target_error);
   y << YAML::Key << "min_paths" << YAML::Value << o.min_paths;

@@ -32,6 +32,9 @@ struct SceneOptions {
   std::string observer = "cie2006_2deg";
   std::string aerosol_phase = "mie";
   bool no_ozone = false;
+  // Exponential air and aerosol profiles and a tent of ozone with the measured columns
+  // (atmosphere/simplify.h; a simplification to measure).
+  bool profiles_exponential = false;
   std::string illumination = "sun";
   double target_error = 0.01;
   uint64_t min_paths = 64;
@@ -55,7 +58,8 @@ struct Scene {
   std::string parameters;  // resolved parameters (YAML) for provenance
 };
 
-// Parses "min:max:step" (nm) into a grid; UsageError when malformed.
+// Parses "min:max:step" (nm), or "rgb" (the three-wavelength grid 680/550/440 nm, whose colour
+// weights are transport/rgb_color.h's), into a grid; UsageError when malformed.
 WavelengthGrid ParseWavelengthGrid(const std::string& text);
 
 // Loads and validates everything; throws InputError (file:line) or UsageError.
