@@ -9,6 +9,7 @@
 //   lut-pack check LUT.ktx2[:WEIGHT] ... --direct DIRECT.exr -o check.json [--sun-cone-deg 5]
 //       decodes the LUT (or the weighted blend of several) at the direct render's sun angles and
 //       directions and reports the luminance error.
+#include <algorithm>
 #include <cctype>
 #include <filesystem>
 #include <set>
@@ -48,6 +49,7 @@ int main(int argc, char** argv) {
               "transmittance, sun and ambient LUTs from sky-render products, and checks decoded LUTs against direct\n"
               "renders. See docs/lut-pack.md.");
   cli.app().require_subcommand(1);
+  cli.app().fallthrough();
   std::string output, depfile, ocio_config;
 
   CLI::App* pack = cli.app().add_subcommand("pack", "Pack the basis skies of one set (one NAME=render.exr per sky)");
@@ -110,11 +112,18 @@ int main(int argc, char** argv) {
       opt.sky_scale = std::ldexp(1.0, static_cast<int>(exposure_stops));
       opt.night_end_zenith_deg = night_end_deg;
       const lut::LutSet set = lut::BuildLutSet(set_in, opt, config, &files_read);
+      {  // each file once, in first-read order (the CMF table is read once per basis sky)
+        std::vector<fs::path> unique;
+        for (const fs::path& f : files_read) {
+          if (std::find(unique.begin(), unique.end(), f) == unique.end()) unique.push_back(f);
+        }
+        files_read = std::move(unique);
+      }
       size_t sky_bytes = 0;
       for (const lut::SkyLutProduct& s : set.skies) sky_bytes += s.sky.bytes.size();
       const double budget_bytes = budget_mib * 1024.0 * 1024.0;
       if (static_cast<double>(sky_bytes) > budget_bytes) {
-        throw UsageError(fmt::format("--budget-mib {}: the {} sky LUTs take {} bytes ({:.4f} MiB)", FormatExact(budget_mib),
+        throw UsageError(fmt::format("--budget-mib {}: the {} sky LUTs take {} bytes ({:.4f} MiB)", budget_mib,
                                      set.skies.size(), sky_bytes, sky_bytes / (1024.0 * 1024.0)));
       }
 
@@ -126,7 +135,16 @@ int main(int argc, char** argv) {
       for (const auto& [name, path] : named) params += "  - " + name + "\n";
       prov.parameters = params;
       for (const fs::path& f : files_read) prov.AddInput(f);
-      std::map<std::string, std::string> files = luttool::EncodeLutSet(set, prov);
+      std::map<std::string, Provenance> sky_prov;
+      for (const auto& [name, path] : named) {
+        Provenance& sp = sky_prov[name];
+        sp.tool = prov.tool;
+        sp.parameters = fmt::format("sky_exposure_stops: {}\nnight_end_zenith_deg: {}\nbasis_sky: {}\n", FormatExact(exposure_stops),
+                                    FormatExact(night_end_deg), name);
+        sp.AddInput(path);
+        for (size_t i = named.size(); i < files_read.size(); ++i) sp.AddInput(files_read[i]);  // OCIO config, CMFs
+      }
+      std::map<std::string, std::string> files = luttool::EncodeLutSet(set, prov, sky_prov);
       luttool::ReportContext ctx;
       for (const auto& [name, bytes] : files) ctx.file_bytes[name] = bytes.size();
       ctx.budget_bytes = budget_bytes;

@@ -52,14 +52,16 @@ dds::Texture Dds(const lut::PackedTexture& t, bool volume) {
 
 }  // namespace
 
-std::map<std::string, std::string> EncodeLutSet(const lut::LutSet& set, const Provenance& prov) {
+std::map<std::string, std::string> EncodeLutSet(const lut::LutSet& set, const Provenance& prov,
+                                                const std::map<std::string, Provenance>& sky_prov) {
   std::map<std::string, std::string> out;
   for (const lut::SkyLutProduct& s : set.skies) {
+    const Provenance& sp = sky_prov.at(s.name);
     const std::string base = "sky_" + s.name;
-    out[base + ".ktx2"] = ktx2::EncodeKtx2(lut::SkyKtx2(set, s, false, prov));
-    out[base + "_array.ktx2"] = ktx2::EncodeKtx2(lut::SkyKtx2(set, s, true, prov));
+    out[base + ".ktx2"] = ktx2::EncodeKtx2(lut::SkyKtx2(set, s, false, sp));
+    out[base + "_array.ktx2"] = ktx2::EncodeKtx2(lut::SkyKtx2(set, s, true, sp));
     out[base + ".dds"] = dds::EncodeDds(Dds(s.sky, true));
-    ExrImage img = InspectionImage(s.sky.width, s.sky.height * s.sky.depth, s.sky, prov);
+    ExrImage img = InspectionImage(s.sky.width, s.sky.height * s.sky.depth, s.sky, sp);
     std::string zen;
     for (double z : s.render->slice_zenith_deg) zen += (zen.empty() ? "" : " ") + FormatExact(z);
     img.strings["skybake.layout"] = fmt::format("{} slices of {}x{} stacked top to bottom (slice k in rows {}k .. {}k + {})",

@@ -16,7 +16,10 @@
 
 namespace skybake::luttool {
 
-// File name (in the output folder) -> bytes.
-std::map<std::string, std::string> EncodeLutSet(const lut::LutSet& set, const Provenance& provenance);
+// File name (in the output folder) -> bytes. A basis sky's own files carry `sky_provenance[name]`
+// (its render alone among the inputs, so that an edit to another sky leaves them byte-identical);
+// the set's files carry `provenance`.
+std::map<std::string, std::string> EncodeLutSet(const lut::LutSet& set, const Provenance& provenance,
+                                                const std::map<std::string, Provenance>& sky_provenance);
 
 }  // namespace skybake::luttool

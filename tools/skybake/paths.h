@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace skybake::paths {
 
@@ -24,6 +25,19 @@ inline std::filesystem::path RenderComponent(const std::string& atm) {
 // outputs/<atm>/sky.exr and sky.png: sky-render's render and preview.
 inline std::filesystem::path Sky(const std::string& atm) { return std::filesystem::path(atm) / "sky.exr"; }
 inline std::filesystem::path SkyPreview(const std::string& atm) { return std::filesystem::path(atm) / "sky.png"; }
+
+// outputs/<atm>/lut_sky.exr: sky-render's render on the GT7 mappings for lut-pack.
+inline std::filesystem::path LutRender(const std::string& atm) { return std::filesystem::path(atm) / "lut_sky.exr"; }
+// outputs/luts/report.json: lut-pack's report; the set's files lie beside it (LutFile).
+inline std::filesystem::path LutReport() { return std::filesystem::path("luts") / "report.json"; }
+inline std::filesystem::path LutFile(const std::string& name) { return std::filesystem::path("luts") / name; }
+// The files lut-pack writes per basis sky and per set (tools/lut-pack/outputs.h).
+inline std::vector<std::string> LutSkyFiles(const std::string& sky) {
+  return {"sky_" + sky + ".ktx2", "sky_" + sky + "_array.ktx2", "sky_" + sky + ".dds", "sky_" + sky + ".exr"};
+}
+inline std::vector<std::string> LutSetFiles() {
+  return {"transmittance.ktx2", "transmittance.dds", "sun.ktx2", "sun.dds", "ambient.ktx2", "ambient.dds", "other_luts.exr"};
+}
 
 // outputs/components/particles/<type>.yaml: the canonical component of a particle type (its
 // file's stem), shared by every atmosphere that uses the type.

@@ -1,0 +1,231 @@
+"""The lut-pack stage of the generated pipeline (issue 6), on a temporary copy of the repo, with a
+reduced-resolution set: 4x8 (2x4 for the cloudy sky) x 5 slices (time mapping gt7:3+2), method
+`single` at low quality on 7 wavelengths, and a tiny particle type for every aerosol.
+
+Checks: a fresh bake runs the LUT renders and one pack edge, then has no work; editing hazed.yaml
+re-renders only hazed (its preview render and its LUT render) and the pack edge, whose clear and
+cloudy textures keep their bytes and mtimes; missingdeps is clean; an unknown basis sky fails with
+pipeline.yaml:line; and the golden check: the reduced bake's texels against tests/lut/golden/.
+
+Golden check (docs/lut-pack.md, "Golden check"): every R11G11B10F code of every texture must be
+within one step of the stored golden's (a rounding boundary crossed by a float difference between
+compilers or CPUs moves a code by one; anything larger is a change of the physics or the packing),
+and at most 2 % of the codes may differ at all; the report's sizes, slice angles and bytes must be
+equal. Update mode: SKYBAKE_UPDATE_GOLDENS=1 rewrites tests/lut/golden/ from this bake and says
+what changed.
+"""
+import hashlib
+import json
+import os
+import re
+import shutil
+import struct
+import sys
+import unittest
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "cli"))
+from skytest import SRC, TempDirTestCase, run, tool  # noqa: E402
+
+GOLDEN = os.path.join(SRC, "tests", "lut", "golden")
+
+PIPELINE = """outputs: outputs
+altitude_step_m: 100
+wavelengths: {min_nm: 400, max_nm: 700, step_nm: 50}
+atmospheres:
+  - atmospheres/clear.yaml
+  - atmospheres/hazed.yaml
+  - atmospheres/cloudy2.yaml
+pools:
+  render: 1
+sky: {size: 4x2, sun_zenith_deg: [40], target_error: 0.5, preview: false}
+luts:
+  method: single
+  quality: low
+  time_mapping: "gt7:3+2"
+  skies:
+    - {atmosphere: clear, size: 4x8}
+    - {atmosphere: hazed, size: 4x8}
+    - {atmosphere: cloudy2, size: 2x4}
+"""
+
+TINY_PARTICLE = """refractive_index:
+  table: ../atmospheres/data/water_refractive_index_segelstein_1981.csv
+modes:
+  - name: small
+    basis: number
+    median_radius_um: 0.1
+    sigma_g: 1.5
+    r_min_um: 0.02
+    r_max_um: 0.5
+    weight: {relative_number: 1.0}
+"""
+
+TEXTURES = ["sky_clear.ktx2", "sky_hazed.ktx2", "sky_cloudy2.ktx2", "transmittance.ktx2", "sun.ktx2", "ambient.ktx2"]
+
+
+def edges_run(ninja_stdout):
+    return [m.group(1) for m in re.finditer(r"^\[\d+/\d+\] (.*)$", ninja_stdout, re.M)]
+
+
+def ktx2_texels(path):
+    """(width, height, depth, layers, level bytes) of a KTX2 file, read with struct (ktxspec
+    'File Structure': 12-byte identifier, 9 UInt32 header fields, index, level index at byte 80)."""
+    with open(path, "rb") as f:
+        data = f.read()
+    assert data[:12] == b"\xabKTX 20\xbb\r\n\x1a\n", path
+    vk, _, w, h, d, layers = struct.unpack_from("<6I", data, 12)
+    assert vk == 122, "not B10G11R11_UFLOAT_PACK32"
+    offset, length = struct.unpack_from("<QQ", data, 80)
+    return w, h, d, layers, data[offset:offset + length]
+
+
+def codes(level):
+    """The R, G, B codes (11, 11, 10 bits) of every texel."""
+    out = []
+    for (word,) in struct.iter_unpack("<I", level):
+        out.append((word & 0x7FF, (word >> 11) & 0x7FF, word >> 22))
+    return out
+
+
+class LutPipelineTest(TempDirTestCase):
+    def setUp(self):
+        super().setUp()
+        shutil.copytree(os.path.join(SRC, "atmospheres"), self.path("atmospheres"))
+        for extra in ("particles", "ocio"):
+            shutil.copytree(os.path.join(SRC, extra), self.path(extra))
+        self.write("pipeline.yaml", PIPELINE)
+        self.write("particles/tiny.yaml", TINY_PARTICLE)
+        for atm in ("clear", "hazed", "cloudy2"):
+            p = self.path("atmospheres", atm + ".yaml")
+            with open(p) as f:
+                text = f.read()
+            text = re.sub(r"particle: \.\./particles/\w+\.yaml", "particle: ../particles/tiny.yaml", text)
+            with open(p, "w") as f:
+                f.write(text)
+        self.out = self.path("outputs")
+
+    def bake(self):
+        r = run([tool("skybake"), "bake", "pipeline.yaml"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+        return r
+
+    def ninja(self, *args, expect=0):
+        r = run(["ninja", "-C", self.out] + list(args))
+        self.assertEqual(r.returncode, expect, r.stdout + r.stderr)
+        return r
+
+    def edit(self, rel, old, new):
+        p = self.path(rel)
+        with open(p) as f:
+            text = f.read()
+        self.assertIn(old, text)
+        with open(p, "w") as f:
+            f.write(text.replace(old, new, 1))
+
+    def mtimes(self):
+        out = {}
+        for root, _, files in os.walk(self.out):
+            for f in files:
+                p = os.path.join(root, f)
+                out[os.path.relpath(p, self.out)] = os.stat(p).st_mtime_ns
+        return out
+
+    def test_fresh_bake_then_no_work_and_an_edit_reruns_only_its_sky(self):
+        r = self.bake()
+        ran = edges_run(r.stdout)
+        for atm in ("clear", "hazed", "cloudy2"):
+            self.assertIn("sky-render %s/lut_sky.exr" % atm, ran)
+        self.assertIn("lut-pack luts/report.json", ran)
+        self.assertEqual(ran.count("lut-pack luts/report.json"), 1)
+        for f in TEXTURES + ["sky_clear_array.ktx2", "sky_clear.dds", "sky_clear.exr", "other_luts.exr", "report.json"]:
+            self.assertTrue(os.path.isfile(os.path.join(self.out, "luts", f)), f)
+        self.assertIn("no work to do", self.ninja("-n").stdout)
+        self.assertIn("No missing dependencies", self.ninja("-t", "missingdeps").stdout)
+
+        before = self.mtimes()
+        self.edit("atmospheres/hazed.yaml", "optical_depth_550nm: 0.5", "optical_depth_550nm: 0.6")
+        r = self.ninja()
+        self.assertEqual(sorted(edges_run(r.stdout)), sorted(["Regenerating build.ninja", "sky-render hazed/sky.exr",
+                                                             "sky-render hazed/lut_sky.exr", "lut-pack luts/report.json"]))
+        after = self.mtimes()
+        for f in ("sky_clear.ktx2", "sky_clear.dds", "sky_cloudy2.ktx2", "sky_cloudy2_array.ktx2"):
+            self.assertEqual(before["luts/" + f], after["luts/" + f], f)
+        for f in ("sky_hazed.ktx2", "sky_hazed.dds", "sun.ktx2", "ambient.ktx2", "report.json"):
+            self.assertNotEqual(before["luts/" + f], after["luts/" + f], f)
+        self.assertEqual(before["clear/lut_sky.exr"], after["clear/lut_sky.exr"])
+        self.assertIn("no work to do", self.ninja("-n").stdout)
+
+    def test_unknown_basis_sky_is_an_error_at_its_line(self):
+        self.edit("pipeline.yaml", "{atmosphere: cloudy2, size: 2x4}", "{atmosphere: cloudy9, size: 2x4}")
+        r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
+        self.assertIn("pipeline.yaml:18: luts.skies: 'cloudy9' is not an atmosphere of this pipeline (clear, hazed, cloudy2)",
+                      r.stderr)
+        self.edit("pipeline.yaml", "{atmosphere: cloudy9, size: 2x4}", "{atmosphere: cloudy2, size: 2x}")
+        r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("pipeline.yaml:18: key 'luts.skies[2].size'", r.stderr)
+
+    def test_golden_reduced_bake(self):
+        self.bake()
+        luts = os.path.join(self.out, "luts")
+        with open(os.path.join(luts, "report.json")) as f:
+            report = json.load(f)
+        summary = {
+            "time_mapping": report["time_mapping"]["name"],
+            "slice_zenith_deg": [round(z, 9) for z in report["time_mapping"]["slice_zenith_deg"]],
+            "skies": [[s["name"], s["size"], s["texel_bytes"]] for s in report["skies"]],
+            "budget_bytes": report["budget"]["sky_lut_texel_bytes"],
+            "textures": {},
+        }
+        for name in TEXTURES:
+            w, h, d, layers, level = ktx2_texels(os.path.join(luts, name))
+            summary["textures"][name] = {"size": [w, h, d, layers], "texels_sha256": hashlib.sha256(level).hexdigest()}
+        if os.environ.get("SKYBAKE_UPDATE_GOLDENS") == "1":
+            self.update_goldens(luts, summary)
+            return
+        manifest = os.path.join(GOLDEN, "manifest.json")
+        self.assertTrue(os.path.isfile(manifest), "no goldens: run with SKYBAKE_UPDATE_GOLDENS=1")
+        with open(manifest) as f:
+            golden = json.load(f)
+        for key in ("time_mapping", "skies", "budget_bytes"):
+            self.assertEqual(summary[key], golden[key], key)
+        for a, b in zip(summary["slice_zenith_deg"], golden["slice_zenith_deg"]):
+            self.assertAlmostEqual(a, b, places=7)
+        lines = []
+        for name in TEXTURES:
+            self.assertEqual(summary["textures"][name]["size"], golden["textures"][name]["size"], name)
+            ours = codes(ktx2_texels(os.path.join(luts, name))[4])
+            with open(os.path.join(GOLDEN, name + ".texels"), "rb") as f:
+                theirs = codes(f.read())
+            self.assertEqual(len(ours), len(theirs), name)
+            worst = max(abs(x - y) for t, g in zip(ours, theirs) for x, y in zip(t, g))
+            differing = sum(1 for t, g in zip(ours, theirs) for x, y in zip(t, g) if x != y)
+            fraction = differing / (3.0 * len(ours))
+            lines.append("%s: %d of %d codes differ (worst by %d step%s)" % (name, differing, 3 * len(ours), worst,
+                                                                            "" if worst == 1 else "s"))
+            self.assertLessEqual(worst, 1, "%s: a code moved by %d steps (SKYBAKE_UPDATE_GOLDENS=1 after a deliberate "
+                                           "change)" % (name, worst))
+            self.assertLessEqual(fraction, 0.02, name)
+        print("golden check:\n  " + "\n  ".join(lines))
+
+    def update_goldens(self, luts, summary):
+        os.makedirs(GOLDEN, exist_ok=True)
+        old = {}
+        manifest = os.path.join(GOLDEN, "manifest.json")
+        if os.path.isfile(manifest):
+            with open(manifest) as f:
+                old = json.load(f).get("textures", {})
+        for name in TEXTURES:
+            level = ktx2_texels(os.path.join(luts, name))[4]
+            with open(os.path.join(GOLDEN, name + ".texels"), "wb") as f:
+                f.write(level)
+            state = "unchanged" if old.get(name) == summary["textures"][name] else "UPDATED"
+            print("golden %s: %s" % (name, state))
+        with open(manifest, "w") as f:
+            json.dump(summary, f, indent=2, sort_keys=True)
+            f.write("\n")
+
+
+if __name__ == "__main__":
+    unittest.main()

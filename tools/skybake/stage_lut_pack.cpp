@@ -1,0 +1,174 @@
+// lut-pack edges: GT7 sky LUTs of the basis skies (docs/lut-pack.md, docs/pipeline.md).
+//
+//   outputs/<atm>/lut_sky.exr         sky-render render on the GT7 mappings (one per basis sky)
+//   outputs/luts/report.json          lut-pack pack of the whole set, with beside it
+//   outputs/luts/sky_<atm>.ktx2 ...   the textures (lut-pack's output list, paths.h)
+//
+// Only with a `luts` section in pipeline.yaml:
+//   luts:
+//     method: orders               # sky-render method of the LUT renders (docs/sky-methods.md)
+//     quality: medium              # its quality preset
+//     time_mapping: gt7-quadratic  # or gt7 (the talk's; docs/lut-pack.md), optionally ":<upper>+<lower>"
+//     sky_exposure_stops: 0        # sky texels store cd/m^2 x 2^stops
+//     budget_mib: 3.5              # lut-pack fails when the sky LUTs exceed it
+//     skies:                       # the basis skies of the set, in row order of the other LUTs
+//       - {atmosphere: clear, size: 32x128}
+//       - {atmosphere: cloudy0, size: 16x64}
+// Each render edge depends on its atmosphere's render component (written by the sky-render
+// stage), profiles and Mie tables, so an edit to one atmosphere re-renders only its LUT and re-runs
+// the pack edge, whose unchanged textures keep their bytes and times (write-if-changed + restat).
+#include <fmt/format.h>
+
+#include <set>
+
+#include "atmosphere/spec.h"
+#include "paths.h"
+#include "stage.h"
+
+namespace skybake {
+
+namespace {
+
+struct LutSky {
+  std::string atmosphere;
+  std::string size;
+  FileLoc loc;
+};
+
+class LutPackStage : public Stage {
+ public:
+  std::string tool() const override { return "lut-pack"; }
+
+  void ParseConfig(YamlMap& root) override {
+    std::optional<YamlMap> luts = root.OptionalMap("luts");
+    if (!luts) return;
+    enabled_ = true;
+    method_ = luts->ChoiceOr("method", {"orders", "single", "ms-approx", "analytic"}, method_);
+    quality_ = luts->ChoiceOr("quality", {"low", "medium", "high"}, quality_);
+    if (std::optional<YamlNode> tm = luts->Get("time_mapping")) {
+      if (std::optional<std::string> s = tm->ToString()) {
+        if (!gt7_names_ok(*s)) {
+          tm->ErrorExpected("gt7 or gt7-quadratic, optionally with :<upper>+<lower> slices (e.g. gt7:3+2)");
+        } else {
+          time_mapping_ = *s;
+        }
+      }
+    }
+    exposure_stops_ = luts->NumberOr("sky_exposure_stops", NumberSpec::Range(-24, 24, "stops"), exposure_stops_);
+    budget_mib_ = luts->NumberOr("budget_mib", NumberSpec::Positive("MiB"), budget_mib_);
+    std::set<std::string> seen;
+    for (const YamlNode& n : luts->Seq("skies")) {
+      YamlMap m = n.ToMap("a mapping {atmosphere: NAME, size: WxH}");
+      if (!m.valid()) continue;
+      LutSky s;
+      s.loc = n.loc();
+      s.atmosphere = m.String("atmosphere", "the name of an atmosphere of the list above");
+      const std::string size = m.String("size", "WxH, e.g. 32x128");
+      int w = 0, h = 0;
+      char tail = 0;
+      if (!size.empty() && (std::sscanf(size.c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w < 2 || h < 2 || w > 4096 || h > 4096)) {
+        m.Get("size")->ErrorExpected("WxH with sides from 2 to 4096, e.g. 32x128");
+      }
+      s.size = size;
+      m.Finish();
+      if (!s.atmosphere.empty() && !seen.insert(s.atmosphere).second) n.Error("basis sky '" + s.atmosphere + "' is listed twice");
+      skies_.push_back(s);
+    }
+    if (skies_.empty()) luts->node().Error("luts.skies: expected at least one basis sky");
+    luts->Finish();
+  }
+
+  void EmitRules(GenContext& ctx) const override {
+    if (!enabled_) return;
+    const std::string pool = ctx.pipeline().pools.count("render") ? "render" : "";
+    ctx.ninja().Rule(ToolRule(ctx, "lut_render", "sky-render", pool));
+    NinjaRule r;
+    r.name = "lut_pack";
+    r.command = ctx.LauncherPrefix(tool()) + ctx.ToolPath(tool()) + " --quiet pack $skies $args --depfile $out.d -o $out";
+    r.description = tool() + " $out";
+    r.depfile = "$out.d";
+    r.deps = "gcc";
+    r.restat = true;
+    ctx.ninja().Rule(r);
+  }
+
+  void EmitEdges(GenContext& ctx) const override {
+    if (!enabled_) return;
+    const auto& wl = ctx.pipeline().wavelengths;
+    Diagnostics diags;
+    std::vector<std::pair<std::string, std::string>> packed;  // name, render path
+    for (const LutSky& s : skies_) {
+      const PipelineAtmosphere* a = nullptr;
+      for (const PipelineAtmosphere& p : ctx.pipeline().atmospheres) {
+        if (p.name == s.atmosphere) a = &p;
+      }
+      if (!a) {
+        std::string names;
+        for (const PipelineAtmosphere& p : ctx.pipeline().atmospheres) names += (names.empty() ? "" : ", ") + p.name;
+        diags.Add(s.loc, "luts.skies: '" + s.atmosphere + "' is not an atmosphere of this pipeline (" + names + ")");
+        continue;
+      }
+      NinjaBuild b;
+      b.outputs = {paths::LutRender(a->name).generic_string()};
+      b.rule = "lut_render";
+      b.inputs = {paths::RenderComponent(a->name).generic_string()};
+      b.implicit_inputs = {ctx.ToolPath("sky-render"), paths::Profiles(a->name).generic_string()};
+      std::set<std::string> particles;
+      for (const AerosolLayerSpec& layer : a->spec.aerosols) {
+        if (layer.particle) particles.insert(layer.particle->stem().string());
+      }
+      for (const std::string& p : particles) b.implicit_inputs.push_back(paths::MieTable(p).generic_string());
+      b.variables = {{"args", fmt::format("render --method {} --quality {} --profiles {} --mie-dir mie --wavelengths {}:{}:{} "
+                                          "--mapping gt7 --size {} --time-mapping {}",
+                                          method_, quality_, paths::Profiles(a->name).generic_string(),
+                                          FormatExact(wl.min_nm), FormatExact(wl.max_nm), FormatExact(wl.step_nm), s.size,
+                                          time_mapping_)}};
+      ctx.Build("sky-render", b);
+      packed.emplace_back(a->name, b.outputs[0]);
+    }
+    diags.ThrowIfAny();
+
+    NinjaBuild b;
+    b.outputs = {paths::LutReport().generic_string()};
+    std::string skies;
+    for (const auto& [name, render] : packed) {
+      b.inputs.push_back(render);
+      skies += (skies.empty() ? "" : " ") + name + "=" + render;
+      for (const std::string& f : paths::LutSkyFiles(name)) b.implicit_outputs.push_back(paths::LutFile(f).generic_string());
+    }
+    for (const std::string& f : paths::LutSetFiles()) b.implicit_outputs.push_back(paths::LutFile(f).generic_string());
+    b.rule = "lut_pack";
+    b.implicit_inputs = {ctx.ToolPath(tool())};
+    b.variables = {{"skies", skies},
+                   {"args", fmt::format("--sky-exposure-stops {} --budget-mib {}", FormatExact(exposure_stops_),
+                                        FormatExact(budget_mib_))}};
+    ctx.Build(tool(), b);
+  }
+
+ private:
+  static bool gt7_names_ok(const std::string& s) {
+    // Mirrors lut/gt7_mapping.h TimeMapping::ParseName (the generator does not link the lut module).
+    const std::string base = s.substr(0, s.find(':'));
+    if (base != "gt7" && base != "gt7-quadratic") return false;
+    if (s.find(':') == std::string::npos) return true;
+    int u = 0, l = 0;
+    char tail = 0;
+    const std::string counts = s.substr(s.find(':') + 1);
+    return std::sscanf(counts.c_str(), "%d+%d%c", &u, &l, &tail) == 2 && u >= 2 && l >= 2 && u + l <= 4096 &&
+           counts == fmt::format("{}+{}", u, l);
+  }
+
+  bool enabled_ = false;
+  std::string method_ = "orders";
+  std::string quality_ = "medium";
+  std::string time_mapping_ = "gt7-quadratic";
+  double exposure_stops_ = 0.0;
+  double budget_mib_ = 3.5;
+  std::vector<LutSky> skies_;
+};
+
+}  // namespace
+
+std::unique_ptr<Stage> MakeLutPackStage() { return std::make_unique<LutPackStage>(); }
+
+}  // namespace skybake
