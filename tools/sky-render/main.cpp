@@ -5,6 +5,7 @@
 //              [--method path] [--mapping equirectangular|fisheye] [--size 64x32]
 //              [--sun-zenith-deg 30,70,85,90,94 | --time-mapping gt7] [--target-error 0.01] [--preview sky.png] ...
 //   sky-render points ATMOSPHERE.yaml --geometry in.csv -o out.csv [--wavelengths-out 440,550,680]
+//   sky-render budget ATMOSPHERE.yaml -o budget.csv [--tolerance 1%] [--method ms-approx] ...
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -26,6 +27,7 @@
 #include "lut/directions.h"
 #include "spectrum/cmf.h"
 #include "spectrum/xyz.h"
+#include "transport/budget.h"
 #include "transport/path_tracer.h"
 #include "transport/sky_render.h"
 #include "transport/sky_scene.h"
@@ -97,9 +99,41 @@ int main(int argc, char** argv) {
   points->add_option("--wavelengths-out", po.wavelengths_nm, "Output wavelengths (nm, on the grid)")->delimiter(',')->default_str("440,550,680");
   points->add_option("--paths", po.paths, "Paths per geometry")->default_val(100000);
 
+  CLI::App* budget = cli.app().add_subcommand(
+      "budget", "Which model simplifications stay under a tolerance, what each costs, which LUT dimensions can be dropped");
+  add_scene_options(budget);
+  BudgetOptions bo;
+  std::string tolerance = "1%", altitude_range;
+  budget->add_option("--tolerance", tolerance, "Largest acceptable relative luminance error, e.g. 1% or 0.01")->default_val("1%");
+  budget->add_option("--criterion", bo.criterion, "rms or max of the error over the sky (outside a 1 deg aureole)")->default_val("rms");
+  budget->add_option("--method", bo.method, "Deterministic evaluator of every item")->default_val("ms-approx");
+  budget->add_option("--quality", bo.quality, "The evaluator's quality: low, medium or high")->default_val("medium");
+  budget->add_option("--sun-zenith-deg", bo.sun_zenith_deg, "Sun zenith angles (deg), comma separated")
+      ->delimiter(',')->default_str("30,70,85,90,94");
+  budget->add_option("--altitude-range-m", altitude_range,
+                     "Observer altitude range lo:hi (m) for the altitude dimension (default: the observer's + 0..300 m)");
+
   return cli.Run(argc, argv, [&] {
     if (ro.sun_zenith_deg.empty()) ro.sun_zenith_deg = {30, 70, 85, 90, 94};
     if (po.wavelengths_nm.empty()) po.wavelengths_nm = {440, 550, 680};
+    if (budget->parsed()) {
+      if (bo.sun_zenith_deg.empty()) bo.sun_zenith_deg = {30, 70, 85, 90, 94};
+      bo.tolerance = ParseTolerance(tolerance);
+      if (!altitude_range.empty()) {
+        double lo = 0.0, hi = 0.0;
+        char tail = 0;
+        if (std::sscanf(altitude_range.c_str(), "%lf:%lf%c", &lo, &hi, &tail) != 2 || lo < 0.0) {
+          throw UsageError("--altitude-range-m: expected lo:hi in m (e.g. 0:300), got '" + altitude_range + "'");
+        }
+        bo.altitude_lo_m = lo;
+        bo.altitude_hi_m = hi;
+      }
+      const BudgetReport rep = RunBudget(scene, bo, cli.Progress());
+      WriteFileIfChanged(output, BudgetCsv(rep));
+      std::fputs(BudgetTable(rep).c_str(), stdout);
+      if (!depfile.empty()) WriteDepfile(depfile, output, rep.files_read);
+      return;
+    }
     // Load and validate (every input file is recorded for the depfile).
     Scene s = LoadScene(scene, cli.Progress());
     if (render->parsed()) {

@@ -56,10 +56,10 @@ WavelengthGrid ParseWavelengthGrid(const std::string& text) {
   std::string item;
   while (std::getline(ss, item, ':')) {
     std::optional<double> v = ParseNumber(item);
-    if (!v) throw UsageError("--wavelengths: expected min:max:step in nm or rgb, got '" + text + "'");
+    if (!v) throw UsageError("--wavelengths: expected min:max:step in nm, got '" + text + "'");
     parts.push_back(*v);
   }
-  if (parts.size() != 3) throw UsageError("--wavelengths: expected min:max:step in nm or rgb, got '" + text + "'");
+  if (parts.size() != 3) throw UsageError("--wavelengths: expected min:max:step in nm, got '" + text + "'");
   try {
     return WavelengthGrid::Uniform(parts[0], parts[1], parts[2]);
   } catch (const InputError& e) {
