@@ -172,7 +172,7 @@ TEST(ParticleType, BadInputsAreReportedWithFileAndLine) {
             f + ":5: unknown key 'modes[0].sigma' (did you mean 'sigma_g'?)\n");
   EXPECT_EQ(with("ln_sigma_g: 0.45", "ln_sigma_g: 0.45\n    sigma_g: 1.5"),
             f + ":3: 'modes[0]' needs exactly one of 'sigma_g' or 'ln_sigma_g', got sigma_g and ln_sigma_g\n");
-  EXPECT_EQ(with("    basis: volume\n", ""), f + ":3: missing key 'modes[0].basis': expected one of 'number' 'volume'\n");
+  EXPECT_EQ(with("    basis: volume\n", ""), f + ":3: missing key 'modes[0].basis': expected one of 'number' or 'volume'\n");
   EXPECT_EQ(with("weight: {relative_volume: 1.0}", "weight: {relative_volume: 1.0, relative_number: 1}"),
             f + ":9: 'modes[0].weight' needs exactly one of 'number_density_cm3', 'relative_number', "
                 "'volume_um3_per_cm3' or 'relative_volume', got relative_number and relative_volume\n");

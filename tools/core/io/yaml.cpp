@@ -392,8 +392,11 @@ std::optional<std::string> YamlMap::OptionalString(std::string_view key, const s
 std::string YamlMap::Choice(std::string_view key, const std::vector<std::string>& choices) {
   std::optional<YamlNode> n = Get(key);
   if (!n) {
-    std::string expected = "one of";
-    for (const auto& c : choices) expected += " '" + c + "'";
+    std::string expected = "one of ";
+    for (size_t i = 0; i < choices.size(); ++i) {
+      if (i) expected += i + 1 == choices.size() ? " or " : ", ";
+      expected += "'" + choices[i] + "'";
+    }
     ErrorMissing(key, expected);
     return {};
   }

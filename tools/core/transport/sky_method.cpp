@@ -5,19 +5,21 @@
 #include <fmt/format.h>
 
 #include "io/error.h"
+#include "transport/method_orders.h"
 #include "transport/method_analytic.h"
 #include "transport/method_ms_approx.h"
 #include "transport/method_single.h"
 
 namespace skybake {
 
-std::vector<std::string> SkyMethodNames() { return {"single", "ms-approx", "analytic"}; }
+std::vector<std::string> SkyMethodNames() { return {"single", "orders", "ms-approx", "analytic"}; }
 
 std::unique_ptr<SkyMethod> MakeSkyMethod(const std::string& name, const AtmosphereModel& model,
                                          const SkyMethodOptions& options, const ProgressFn& progress) {
   if (name == "single") return MakeSingleMethod(model, options);
   if (name == "ms-approx") return MakeMsApproxMethod(model, options, progress);
   if (name == "analytic") return MakeAnalyticMethod(model, options);
+  if (name == "orders") return MakeOrdersMethod(model, options, progress);
   std::string known;
   for (const std::string& n : SkyMethodNames()) known += (known.empty() ? "" : ", ") + n;
   throw UsageError("--method: expected path, " + known + "; got '" + name + "'");

@@ -27,6 +27,9 @@ struct SkyMethodOptions {
   int orders = 0;            // highest scattering order (orders: stop earlier if converged)
   double order_tolerance = 0.0;  // orders: stop when an order adds less than this fraction
   std::map<std::string, int> table_size;  // orders: named table resolutions (docs/sky-methods.md)
+  // Observer altitude the tables are built for (orders puts a radius node there; other
+  // altitudes are interpolated between nodes).
+  double observer_altitude_m = 0.0;
 };
 
 class SkyMethod {

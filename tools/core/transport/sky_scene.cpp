@@ -180,7 +180,9 @@ RenderProducts RenderProductsOf(const Scene& scene, const RenderOptions& o, cons
     PathTracer tracer(scene.model, scene.xyz_weights, scene.tracer);
     p.sky = RenderSky(tracer, p.settings, progress);
   } else {
-    std::unique_ptr<SkyMethod> method = MakeSkyMethod(o.method, scene.model, o.method_options, progress);
+    SkyMethodOptions mo = o.method_options;
+    mo.observer_altitude_m = p.settings.observer_altitude_m;
+    std::unique_ptr<SkyMethod> method = MakeSkyMethod(o.method, scene.model, mo, progress);
     p.sky = RenderSkyDeterministic(*method, scene.model, scene.xyz_weights, p.settings, progress);
     p.method_description = method->Describe();
   }

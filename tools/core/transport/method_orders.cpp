@@ -1,0 +1,903 @@
+#include "transport/method_orders.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <mutex>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "io/error.h"
+
+namespace skybake {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kDeg = kPi / 180.0;
+
+// ---------------------------------------------------------------------------- settings
+
+struct OrdersSettings {
+  int nr = 16;               // radius nodes (+ the observer's)
+  int nup = 16, ndn = 8;     // view nodes above / below each altitude's horizon
+  int nphi = 8;              // azimuth nodes on [0, pi]
+  int nt = 40;               // steps along a table ray
+  int nss = 96;              // steps along an output view ray (single scattering)
+  int fine = 256;            // pieces for optical depths along a ray
+  double truncation_deg = 15.0;
+  int max_orders = 40;
+  double tolerance = 1e-3;
+  std::vector<double> sun_deg;  // sun zenith nodes
+};
+
+OrdersSettings SettingsFor(const SkyMethodOptions& o) {
+  OrdersSettings s;
+  if (o.quality == "low") {
+    s.nr = 10, s.nup = 10, s.ndn = 6, s.nphi = 6, s.nt = 24, s.nss = 48, s.fine = 128, s.tolerance = 3e-3;
+  } else if (o.quality == "medium") {
+    // defaults above
+  } else if (o.quality == "high") {
+    s.nr = 24, s.nup = 24, s.ndn = 12, s.nphi = 12, s.nt = 64, s.nss = 160, s.fine = 512, s.tolerance = 3e-4;
+  } else {
+    throw UsageError("--quality: expected low, medium or high, got '" + o.quality + "'");
+  }
+  auto get = [&](const char* key, int* v) {
+    auto it = o.table_size.find(key);
+    if (it != o.table_size.end()) *v = it->second;
+  };
+  get("radius", &s.nr);
+  get("view_up", &s.nup);
+  get("view_down", &s.ndn);
+  get("azimuth", &s.nphi);
+  get("ray_steps", &s.nt);
+  get("view_steps", &s.nss);
+  if (o.view_steps > 0) s.nss = o.view_steps;
+  if (o.orders > 0) s.max_orders = o.orders;
+  if (o.order_tolerance > 0) s.tolerance = o.order_tolerance;
+  // Sun zenith nodes: every 10 deg up to 80, then 2.5 deg to 90, 1 deg through twilight to
+  // 110, then 112, 115, 120 (beyond: no sunlight reaches the atmosphere's sunlit part that
+  // matters; J is taken as 0). "high" halves the twilight step.
+  for (double a = 0; a < 80; a += 10) s.sun_deg.push_back(a);
+  for (double a = 80; a < 90; a += 2.5) s.sun_deg.push_back(a);
+  const double tw = o.quality == "high" ? 0.5 : 1.0;
+  for (double a = 90; a <= 110 + 1e-9; a += tw) s.sun_deg.push_back(a);
+  for (double a : {112.0, 115.0, 120.0}) s.sun_deg.push_back(a);
+  if (s.nr < 3 || s.nup < 2 || s.ndn < 2 || s.nphi < 2 || s.nt < 4 || s.nss < 4) {
+    throw UsageError("orders: table sizes are too small");
+  }
+  return s;
+}
+
+// Linear interpolation position on a sorted grid: index of the lower node and weight of the upper.
+struct Lerp {
+  size_t i = 0;
+  double t = 0.0;
+};
+Lerp Locate(const std::vector<double>& x, double v) {
+  if (v <= x.front()) return {0, 0.0};
+  if (v >= x.back()) return {x.size() - 2, 1.0};
+  size_t i = static_cast<size_t>(std::upper_bound(x.begin(), x.end(), v) - x.begin()) - 1;
+  return {i, (v - x[i]) / (x[i + 1] - x[i])};
+}
+
+// ---------------------------------------------------------------------------- the method
+
+class OrdersMethod : public SkyMethod {
+ public:
+  OrdersMethod(const AtmosphereModel& model, const SkyMethodOptions& options, const ProgressFn& progress)
+      : m_(model), s_(SettingsFor(options)), nw_(model.wavelengths()) {
+    observer_altitude_m_ = options.observer_altitude_m;
+    PrepareMedium();
+    BuildSunTables();
+    BuildRadiusNodes();
+    SolveMultipleScattering(progress);
+  }
+
+  std::string Name() const override { return "orders"; }
+
+  std::string Describe() const override {
+    return fmt::format(
+        "method: orders\nradius_nodes: {}\nview_nodes: {} up + {} down per altitude\nazimuth_nodes: {}\n"
+        "sun_nodes: {}\nray_steps: {}\nview_steps: {}\ntruncation_deg: {}\norders_computed: {}\n"
+        "tail_extrapolated: {}\nlast_order_fraction: {:.3g}\ntolerance: {}\n",
+        radius_.size(), s_.nup, s_.ndn, s_.nphi, s_.sun_deg.size(), s_.nt, s_.nss, s_.truncation_deg, orders_done_,
+        tail_ ? "true" : "false", last_fraction_, s_.tolerance);
+  }
+
+  void Radiance(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,
+                std::vector<double>* out) const override;
+
+ private:
+  // --- medium: per model level, wavelength innermost (float)
+  void PrepareMedium();
+  // Coefficients at altitude z into per-wavelength buffers.
+  void SigmaT(double z, bool scaled, float* out) const;
+  void SigmaS(size_t c, double z, bool scaled, float* out) const;
+
+  // --- sun transmittance averaged over the solar disk, T(r, theta_s) per wavelength
+  void BuildSunTables();
+  // Disk-averaged sun transmittance at radius r and sun zenith cosine mu_s into out[w].
+  void SunTransmittance(double r, double mu_s, bool scaled, float* out) const;
+  // Optical depths (unscaled, truncated part) along a ray from r with cosine mu to the top;
+  // false if it hits the ground.
+  bool RayDepth(double r, double mu, std::vector<double>* tau, std::vector<double>* tau_f) const;
+
+  // --- multiple-scattering tables
+  void BuildRadiusNodes();
+  double HorizonMu(double r) const {
+    const double q = m_.bottom_radius_m / r;
+    return -std::sqrt(std::max(0.0, 1.0 - q * q));
+  }
+  // View node k (0..nu-1, ascending mu) at radius r, its solid-angle width in mu.
+  double ViewMu(size_t k, double r) const;
+  double ViewWidth(size_t k, double r) const;
+  // Fractional view index of mu at radius r (up and down parts are not interpolated across).
+  void ViewIndex(double mu, double r, size_t* k0, size_t* k1, double* t) const;
+  void SolveMultipleScattering(const ProgressFn& progress);
+
+  size_t Cell(size_t ri, size_t si, size_t k, size_t q) const {
+    return ((ri * ns_ + si) * nu_ + k) * static_cast<size_t>(s_.nphi) + q;
+  }
+
+  // Interpolates table `tab` (cells x nw) at a point, accumulating weight * value into acc.
+  void Interpolate(const std::vector<float>& tab, double r, double theta_s, double mu, double cos_phi, double weight,
+                   float* acc) const;
+
+  const AtmosphereModel& m_;
+  OrdersSettings s_;
+  const size_t nw_;
+  double observer_altitude_m_ = 0.0;
+  size_t nc_ = 0;  // scattering components
+
+  // Medium per model level l: sigma_t[l*nw+w], sigma_t*[..], sigma_s_c[(c*nl+l)*nw+w], sigma_s*_c.
+  std::vector<float> sigma_t_, sigma_t_star_, sigma_s_, sigma_s_star_;
+  std::vector<std::shared_ptr<const PhaseModel>> phase_;  // per component
+  std::vector<double> f_;                                   // truncated fraction [c*nw+w]
+  std::vector<float> phase_star_;                           // [(c*ng+g)*nw+w] on cos grid
+  static constexpr int kPhaseGrid = 2048;
+  std::vector<double> albedo_, sun_e_;
+
+  // Sun transmittance tables: radius nodes x theta nodes x nw (unscaled and scaled).
+  std::vector<double> sun_r_, sun_theta_deg_;
+  std::vector<float> sun_t_, sun_t_star_;
+
+  // MS tables.
+  std::vector<double> radius_;  // radius nodes (m); obs_index_ is the observer's
+  size_t obs_index_ = 0;
+  size_t ns_ = 0, nu_ = 0;
+  std::vector<double> sun_theta_rad_;
+  std::vector<float> ms_;  // accumulated orders >= 2 at the observer radius: [(si*nu+k)*nphi+q]*nw
+  int orders_done_ = 0;
+  bool tail_ = false;
+  double last_fraction_ = 0.0;
+};
+
+// ---------------------------------------------------------------------------- medium
+
+void OrdersMethod::PrepareMedium() {
+  const size_t nl = m_.levels();
+  for (const MediumComponent& c : m_.components) {
+    if (c.phase) phase_.push_back(c.phase);
+  }
+  nc_ = phase_.size();
+  albedo_ = m_.ground_albedo;
+  sun_e_ = m_.sun.irradiance;
+
+  // Truncated fractions and truncated phase functions on a uniform grid in cos(theta).
+  const double cos_c = std::cos(s_.truncation_deg * kDeg);
+  f_.assign(nc_ * nw_, 0.0);
+  phase_star_.assign(nc_ * kPhaseGrid * nw_, 0.0f);
+  for (size_t c = 0; c < nc_; ++c) {
+    for (size_t w = 0; w < nw_; ++w) {
+      // f = 2 pi int_{cos_c}^{1} (P(mu) - P(cos_c)) dmu, integrated in theta on a log grid
+      // (the forward peak of large particles is ~1/x rad wide).
+      const double p_c = phase_[c]->Eval(w, cos_c);
+      const int n = 4000;
+      const double th_min = 1e-5, th_max = s_.truncation_deg * kDeg;
+      double f = 0.0, prev_th = 0.0, prev_v = 2 * kPi * std::max(0.0, phase_[c]->Eval(w, 1.0) - p_c) * 0.0;
+      for (int i = 0; i <= n; ++i) {
+        const double th = th_min * std::pow(th_max / th_min, static_cast<double>(i) / n);
+        const double v = 2 * kPi * std::max(0.0, phase_[c]->Eval(w, std::cos(th)) - p_c) * std::sin(th);
+        f += 0.5 * (v + prev_v) * (th - prev_th);
+        prev_th = th;
+        prev_v = v;
+      }
+      f = std::clamp(f, 0.0, 0.999);
+      f_[c * nw_ + w] = f;
+      for (int g = 0; g < kPhaseGrid; ++g) {
+        const double mu = -1.0 + 2.0 * g / (kPhaseGrid - 1);
+        const double p = mu > cos_c ? p_c : phase_[c]->Eval(w, mu);
+        phase_star_[(c * kPhaseGrid + g) * nw_ + w] = static_cast<float>(p / (1.0 - f));
+      }
+    }
+  }
+
+  sigma_t_.assign(nl * nw_, 0.0f);
+  sigma_t_star_.assign(nl * nw_, 0.0f);
+  sigma_s_.assign(nc_ * nl * nw_, 0.0f);
+  sigma_s_star_.assign(nc_ * nl * nw_, 0.0f);
+  for (size_t l = 0; l < nl; ++l) {
+    const AtmosphereModel::Cell cell{std::min(l, nl - 2), l == nl - 1 ? 1.0 : 0.0};
+    size_t c = 0;
+    for (size_t comp = 0; comp < m_.components.size(); ++comp) {
+      const MediumComponent& mc = m_.components[comp];
+      for (size_t w = 0; w < nw_; ++w) {
+        const double ss = mc.scattering[l * nw_ + w], sa = mc.absorption[l * nw_ + w];
+        sigma_t_[l * nw_ + w] += static_cast<float>(ss + sa);
+        double trunc = 0.0;
+        if (mc.phase) {
+          trunc = f_[c * nw_ + w] * ss;
+          sigma_s_[(c * nl + l) * nw_ + w] = static_cast<float>(ss);
+          sigma_s_star_[(c * nl + l) * nw_ + w] = static_cast<float>(ss - trunc);
+        }
+        sigma_t_star_[l * nw_ + w] += static_cast<float>(ss + sa - trunc);
+      }
+      (void)cell;
+      if (mc.phase) ++c;
+    }
+  }
+}
+
+void OrdersMethod::SigmaT(double z, bool scaled, float* out) const {
+  const AtmosphereModel::Cell c = m_.Locate(z);
+  const std::vector<float>& s = scaled ? sigma_t_star_ : sigma_t_;
+  const float* a = &s[c.i * nw_];
+  const float* b = &s[(c.i + 1) * nw_];
+  const float t = static_cast<float>(c.t);
+  for (size_t w = 0; w < nw_; ++w) out[w] = a[w] + (b[w] - a[w]) * t;
+}
+
+void OrdersMethod::SigmaS(size_t comp, double z, bool scaled, float* out) const {
+  const AtmosphereModel::Cell c = m_.Locate(z);
+  const size_t nl = m_.levels();
+  const std::vector<float>& s = scaled ? sigma_s_star_ : sigma_s_;
+  const float* a = &s[(comp * nl + c.i) * nw_];
+  const float* b = &s[(comp * nl + c.i + 1) * nw_];
+  const float t = static_cast<float>(c.t);
+  for (size_t w = 0; w < nw_; ++w) out[w] = a[w] + (b[w] - a[w]) * t;
+}
+
+// ---------------------------------------------------------------------------- sun tables
+
+bool OrdersMethod::RayDepth(double r, double mu, std::vector<double>* tau, std::vector<double>* tau_f) const {
+  const double R = m_.bottom_radius_m, top = m_.top_radius_m;
+  tau->assign(nw_, 0.0);
+  tau_f->assign(nw_, 0.0);
+  const double disc_g = r * r * (mu * mu - 1.0) + R * R;
+  if (mu < 0.0 && disc_g >= 0.0) return false;  // hits the ground
+  const double length = -r * mu + std::sqrt(std::max(0.0, r * r * (mu * mu - 1.0) + top * top));
+  const int pieces = s_.fine;
+  const double h = length / pieces;
+  static const double kG = 0.5773502691896257;
+  std::vector<float> st(nw_), sts(nw_);
+  for (int p = 0; p < pieces; ++p) {
+    for (double g : {-kG, kG}) {
+      const double t = (p + 0.5 + 0.5 * g) * h;
+      const double rr = std::sqrt(r * r + 2.0 * r * mu * t + t * t);
+      SigmaT(rr - R, false, st.data());
+      SigmaT(rr - R, true, sts.data());
+      for (size_t w = 0; w < nw_; ++w) {
+        (*tau)[w] += 0.5 * h * st[w];
+        (*tau_f)[w] += 0.5 * h * (st[w] - sts[w]);
+      }
+    }
+  }
+  return true;
+}
+
+void OrdersMethod::BuildSunTables() {
+  const double R = m_.bottom_radius_m, H = m_.top_radius_m - R;
+  // Radius nodes: quadratic in altitude (dense near the ground).
+  const int nr = 48;
+  for (int i = 0; i < nr; ++i) sun_r_.push_back(R + H * std::pow(static_cast<double>(i) / (nr - 1), 2.0));
+  // Sun zenith nodes (deg): 1 deg to 80, 0.05 deg to 110 (the horizon and the Earth's shadow), 1 deg to 125.
+  for (double a = 0; a < 80; a += 1.0) sun_theta_deg_.push_back(a);
+  for (double a = 80; a < 110; a += 0.05) sun_theta_deg_.push_back(a);
+  for (double a = 110; a <= 125 + 1e-9; a += 1.0) sun_theta_deg_.push_back(a);
+  const size_t nt = sun_theta_deg_.size();
+  std::vector<float> base(nr * nt * nw_), base_star(nr * nt * nw_);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, static_cast<size_t>(nr) * nt, 8), [&](const tbb::blocked_range<size_t>& rg) {
+    std::vector<double> tau, tau_f;
+    for (size_t k = rg.begin(); k != rg.end(); ++k) {
+      const size_t i = k / nt, j = k % nt;
+      const bool clear = RayDepth(sun_r_[i], std::cos(sun_theta_deg_[j] * kDeg), &tau, &tau_f);
+      for (size_t w = 0; w < nw_; ++w) {
+        base[k * nw_ + w] = clear ? static_cast<float>(std::exp(-tau[w])) : 0.0f;
+        base_star[k * nw_ + w] = clear ? static_cast<float>(std::exp(-(tau[w] - tau_f[w]))) : 0.0f;
+      }
+    }
+  });
+  // Average over the solar disk in elevation: offsets delta_i across the disk with weights =
+  // chord length x limb darkening (mean over the wavelengths' coefficients, a stated
+  // simplification: the limb darkening shapes the penumbra only), 16-point midpoint rule.
+  const double alpha = m_.sun.angular_radius_rad;
+  constexpr int kDisk = 16;
+  std::vector<double> delta(kDisk), weight(kDisk);
+  double wsum = 0.0;
+  for (int i = 0; i < kDisk; ++i) {
+    const double y = -1.0 + (i + 0.5) * 2.0 / kDisk;  // vertical position on the disk / radius
+    delta[i] = y * alpha;
+    // Integrate the limb-darkened radiance along the chord at height y (32 points).
+    double chord = 0.0;
+    const double half = std::sqrt(1.0 - y * y);
+    for (int q = 0; q < 32; ++q) {
+      const double x = -half + (q + 0.5) * 2.0 * half / 32;
+      const double rr = std::min(1.0, std::sqrt(x * x + y * y));
+      const double mu = std::sqrt(1.0 - rr * rr);
+      double ld = 1.0;
+      if (!m_.sun.limb_coefficients.empty()) {
+        ld = 0.0;
+        double p = 1.0;
+        const std::array<double, 6>& a = m_.sun.limb_coefficients[m_.sun.limb_coefficients.size() / 2];
+        for (int c = 0; c < 6; ++c) {
+          ld += a[static_cast<size_t>(c)] * p;
+          p *= mu;
+        }
+      }
+      chord += ld * 2.0 * half / 32;
+    }
+    weight[i] = chord;
+    wsum += chord;
+  }
+  for (double& v : weight) v /= wsum;
+  sun_t_.assign(nr * nt * nw_, 0.0f);
+  sun_t_star_.assign(nr * nt * nw_, 0.0f);
+  for (size_t i = 0; i < static_cast<size_t>(nr); ++i) {
+    for (size_t j = 0; j < nt; ++j) {
+      for (int d = 0; d < kDisk; ++d) {
+        const double th = sun_theta_deg_[j] - delta[d] / kDeg;  // elevation offset
+        const Lerp l = Locate(sun_theta_deg_, th);
+        const float* a = &base[(i * nt + l.i) * nw_];
+        const float* b = &base[(i * nt + l.i + 1) * nw_];
+        const float* as = &base_star[(i * nt + l.i) * nw_];
+        const float* bs = &base_star[(i * nt + l.i + 1) * nw_];
+        const float t = static_cast<float>(l.t), wt = static_cast<float>(weight[d]);
+        float* o = &sun_t_[(i * nt + j) * nw_];
+        float* os = &sun_t_star_[(i * nt + j) * nw_];
+        for (size_t w = 0; w < nw_; ++w) {
+          o[w] += wt * (a[w] + (b[w] - a[w]) * t);
+          os[w] += wt * (as[w] + (bs[w] - as[w]) * t);
+        }
+      }
+    }
+  }
+}
+
+void OrdersMethod::SunTransmittance(double r, double mu_s, bool scaled, float* out) const {
+  const Lerp lr = Locate(sun_r_, r);
+  const Lerp lt = Locate(sun_theta_deg_, std::acos(std::clamp(mu_s, -1.0, 1.0)) / kDeg);
+  const size_t nt = sun_theta_deg_.size();
+  const std::vector<float>& tab = scaled ? sun_t_star_ : sun_t_;
+  const float* p00 = &tab[(lr.i * nt + lt.i) * nw_];
+  const float* p01 = &tab[(lr.i * nt + lt.i + 1) * nw_];
+  const float* p10 = &tab[((lr.i + 1) * nt + lt.i) * nw_];
+  const float* p11 = &tab[((lr.i + 1) * nt + lt.i + 1) * nw_];
+  const float a = static_cast<float>(lr.t), b = static_cast<float>(lt.t);
+  const float w00 = (1 - a) * (1 - b), w01 = (1 - a) * b, w10 = a * (1 - b), w11 = a * b;
+  for (size_t w = 0; w < nw_; ++w) out[w] = w00 * p00[w] + w01 * p01[w] + w10 * p10[w] + w11 * p11[w];
+}
+
+// ---------------------------------------------------------------------------- MS tables
+
+void OrdersMethod::BuildRadiusNodes() {
+  const double R = m_.bottom_radius_m, H = m_.top_radius_m - R;
+  // Altitude h_i = H (i/(n-1))^2.5: 0, 0.12, 0.65, 1.8, 3.7, 6.4, 10 ... 100 km for n = 16.
+  for (int i = 0; i < s_.nr; ++i) radius_.push_back(R + H * std::pow(static_cast<double>(i) / (s_.nr - 1), 2.5));
+  const double r_obs = R + std::clamp(observer_altitude_m_, 0.0, H * 0.999);
+  auto it = std::lower_bound(radius_.begin(), radius_.end(), r_obs);
+  if (it != radius_.end() && std::abs(*it - r_obs) < 1e-6) {
+    obs_index_ = static_cast<size_t>(it - radius_.begin());
+  } else {
+    obs_index_ = static_cast<size_t>(it - radius_.begin());
+    radius_.insert(it, r_obs);
+  }
+  for (double d : s_.sun_deg) sun_theta_rad_.push_back(d * kDeg);
+  ns_ = sun_theta_rad_.size();
+  nu_ = static_cast<size_t>(s_.nup + s_.ndn);
+}
+
+// View nodes, in ascending mu: k < ndn below the horizon from the nadir to the horizon's lower
+// side, mu = mu_h - (mu_h + 1)(1 - s)^2, s = k/(ndn-1); k >= ndn above it from the horizon's upper
+// side to the zenith, mu = mu_h + (1 - mu_h) s^2, s = (k-ndn)/(nup-1). Both sets include their
+// ends (the horizon on each side of the discontinuity, the zenith, the nadir) and are dense next
+// to the horizon; integrals use the trapezoid rule on each set.
+double OrdersMethod::ViewMu(size_t k, double r) const {
+  const double mh = HorizonMu(r);
+  if (k < static_cast<size_t>(s_.ndn)) {
+    const double s = static_cast<double>(k) / (s_.ndn - 1);
+    return mh - (mh + 1.0) * (1.0 - s) * (1.0 - s);
+  }
+  const double s = static_cast<double>(k - s_.ndn) / (s_.nup - 1);
+  return mh + (1.0 - mh) * s * s;
+}
+
+double OrdersMethod::ViewWidth(size_t k, double r) const {
+  // Trapezoid weight: half the distance between the neighbours within the node's own set.
+  const bool down = k < static_cast<size_t>(s_.ndn);
+  const size_t lo = down ? 0 : static_cast<size_t>(s_.ndn);
+  const size_t hi = down ? static_cast<size_t>(s_.ndn) - 1 : nu_ - 1;
+  const double m = ViewMu(k, r);
+  const double left = k > lo ? ViewMu(k - 1, r) : m;
+  const double right = k < hi ? ViewMu(k + 1, r) : m;
+  return 0.5 * (right - left);
+}
+
+void OrdersMethod::ViewIndex(double mu, double r, size_t* k0, size_t* k1, double* t) const {
+  const double mh = HorizonMu(r);
+  double f;
+  size_t base, n;
+  if (mu >= mh) {
+    const double s = std::sqrt(std::clamp((mu - mh) / (1.0 - mh), 0.0, 1.0));
+    f = s * (s_.nup - 1);
+    base = static_cast<size_t>(s_.ndn);
+    n = static_cast<size_t>(s_.nup);
+  } else {
+    const double s = 1.0 - std::sqrt(std::clamp((mh - mu) / (mh + 1.0), 0.0, 1.0));
+    f = s * (s_.ndn - 1);
+    base = 0;
+    n = static_cast<size_t>(s_.ndn);
+  }
+  f = std::clamp(f, 0.0, static_cast<double>(n - 1));
+  const size_t i = std::min(static_cast<size_t>(f), n - 2);
+  *k0 = base + i;
+  *k1 = base + i + 1;
+  *t = f - static_cast<double>(i);
+}
+
+void OrdersMethod::Interpolate(const std::vector<float>& tab, double r, double theta_s, double mu, double cos_phi,
+                               double weight, float* acc) const {
+  const Lerp lr = Locate(radius_, r);
+  if (theta_s > sun_theta_rad_.back()) return;  // beyond the last sun node: no light
+  const Lerp ls = Locate(sun_theta_rad_, theta_s);
+  const double phi = std::acos(std::clamp(cos_phi, -1.0, 1.0));
+  double fq = phi / kPi * s_.nphi - 0.5;
+  fq = std::clamp(fq, 0.0, static_cast<double>(s_.nphi - 1));
+  const size_t q0 = std::min(static_cast<size_t>(fq), static_cast<size_t>(s_.nphi - 2));
+  const double tq = fq - static_cast<double>(q0);
+  for (int dr = 0; dr < 2; ++dr) {
+    const size_t ri = lr.i + static_cast<size_t>(dr);
+    const double wr = dr ? lr.t : 1.0 - lr.t;
+    if (wr == 0.0) continue;
+    size_t k0, k1;
+    double tk;
+    ViewIndex(mu, radius_[ri], &k0, &k1, &tk);
+    for (int ds = 0; ds < 2; ++ds) {
+      const size_t si = ls.i + static_cast<size_t>(ds);
+      const double ws = wr * (ds ? ls.t : 1.0 - ls.t);
+      if (ws == 0.0) continue;
+      for (int dk = 0; dk < 2; ++dk) {
+        const double wk = ws * (dk ? tk : 1.0 - tk);
+        if (wk == 0.0) continue;
+        const size_t k = dk ? k1 : k0;
+        for (int dq = 0; dq < 2; ++dq) {
+          const float wq = static_cast<float>(weight * wk * (dq ? tq : 1.0 - tq));
+          if (wq == 0.0f) continue;
+          const float* v = &tab[Cell(ri, si, k, q0 + static_cast<size_t>(dq)) * nw_];
+          for (size_t w = 0; w < nw_; ++w) acc[w] += wq * v[w];
+        }
+      }
+    }
+  }
+}
+
+void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
+  const double R = m_.bottom_radius_m, top = m_.top_radius_m;
+  const size_t nr = radius_.size(), nphi = static_cast<size_t>(s_.nphi);
+  const size_t cells = nr * ns_ * nu_ * nphi;
+  const size_t nt = static_cast<size_t>(s_.nt);
+
+  // Ray families: for each (radius node, view node) the table ray's steps (shared by every sun
+  // node and azimuth): midpoints t, widths dt, their radius and local view cosine, the scaled
+  // transmittance from the start, and the ground hit.
+  struct Family {
+    std::vector<double> t, dt, r, mu;
+    std::vector<float> trans;  // [step * nw + w]
+    bool ground = false;
+    double d = 0.0;
+    std::vector<float> trans_end;  // at the ground
+  };
+  std::vector<Family> fam(nr * nu_);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nr * nu_, 1), [&](const tbb::blocked_range<size_t>& rg) {
+    std::vector<float> st(nw_);
+    for (size_t idx = rg.begin(); idx != rg.end(); ++idx) {
+      const size_t ri = idx / nu_, k = idx % nu_;
+      const double r = radius_[ri], mu = ViewMu(k, r);
+      Family& f = fam[idx];
+      const double disc_g = r * r * (mu * mu - 1.0) + R * R;
+      f.ground = mu < 0.0 && disc_g >= 0.0;
+      f.d = f.ground ? -r * mu - std::sqrt(std::max(0.0, disc_g))
+                     : -r * mu + std::sqrt(std::max(0.0, r * r * (mu * mu - 1.0) + top * top));
+      if (f.d <= 0.0) {  // on the ground looking down: nothing but the ground
+        f.d = 0.0;
+        f.trans_end.assign(nw_, 1.0f);
+        continue;
+      }
+      // Fine optical depth (reference wavelength: the middle of the grid) to place the steps
+      // uniformly in (tau_ref/tau_total + t/d)/2: dense where the medium is.
+      const int nf = s_.fine;
+      std::vector<double> cum(static_cast<size_t>(nf) + 1, 0.0);
+      std::vector<std::vector<float>> cum_w(static_cast<size_t>(nf) + 1, std::vector<float>(nw_, 0.0f));
+      const size_t wref = nw_ / 2;
+      for (int p = 0; p < nf; ++p) {
+        const double tm = (p + 0.5) * f.d / nf;
+        const double rr = std::sqrt(r * r + 2.0 * r * mu * tm + tm * tm);
+        SigmaT(rr - R, true, st.data());
+        cum[static_cast<size_t>(p) + 1] = cum[static_cast<size_t>(p)] + st[wref] * f.d / nf;
+        for (size_t w = 0; w < nw_; ++w) cum_w[static_cast<size_t>(p) + 1][w] = cum_w[static_cast<size_t>(p)][w] + st[w] * static_cast<float>(f.d / nf);
+      }
+      const double tau_total = std::max(cum.back(), 1e-12);
+      // Parameter s(t) at the fine nodes; invert for step edges.
+      std::vector<double> s_at(static_cast<size_t>(nf) + 1);
+      for (int p = 0; p <= nf; ++p) s_at[static_cast<size_t>(p)] = 0.5 * (cum[static_cast<size_t>(p)] / tau_total + static_cast<double>(p) / nf);
+      auto t_of_s = [&](double sv) {
+        const Lerp l = Locate(s_at, sv);
+        return (static_cast<double>(l.i) + l.t) * f.d / nf;
+      };
+      f.trans.resize(nt * nw_);
+      for (size_t m = 0; m < nt; ++m) {
+        const double t0 = t_of_s(static_cast<double>(m) / nt), t1 = t_of_s(static_cast<double>(m + 1) / nt);
+        const double tm = 0.5 * (t0 + t1);
+        f.t.push_back(tm);
+        f.dt.push_back(t1 - t0);
+        const double rr = std::sqrt(r * r + 2.0 * r * mu * tm + tm * tm);
+        f.r.push_back(rr);
+        f.mu.push_back((r * mu + tm) / rr);
+        const double pf = tm / f.d * nf;
+        const size_t pi = std::min(static_cast<size_t>(pf), static_cast<size_t>(nf) - 1);
+        const float pt = static_cast<float>(pf - static_cast<double>(pi));
+        for (size_t w = 0; w < nw_; ++w) {
+          const float tau = cum_w[pi][w] + (cum_w[pi + 1][w] - cum_w[pi][w]) * pt;
+          f.trans[m * nw_ + w] = std::exp(-tau);
+        }
+      }
+      f.trans_end.resize(nw_);
+      for (size_t w = 0; w < nw_; ++w) f.trans_end[w] = std::exp(-cum_w.back()[w]);
+    }
+  });
+
+  // Per-cell geometry helpers.
+  auto cell_geometry = [&](size_t ri, size_t si, size_t k, size_t q, double* mu, double* nu) {
+    const double r = radius_[ri];
+    *mu = ViewMu(k, r);
+    const double phi = (q + 0.5) * kPi / s_.nphi;
+    const double ts = sun_theta_rad_[si];
+    *nu = std::sqrt(std::max(0.0, 1.0 - *mu * *mu)) * std::cos(phi) * std::sin(ts) + *mu * std::cos(ts);
+  };
+
+  // Irradiance at the ground from a table of radiance (upper view nodes at radius node 0):
+  // E[si*nw + w] = sum over up nodes and both azimuth halves of L mu dOmega.
+  auto ground_irradiance = [&](const std::vector<float>& L, std::vector<float>* E) {
+    E->assign(ns_ * nw_, 0.0f);
+    for (size_t si = 0; si < ns_; ++si) {
+      for (size_t k = static_cast<size_t>(s_.ndn); k < nu_; ++k) {
+        const double mu = ViewMu(k, R), dmu = ViewWidth(k, R);
+        for (size_t q = 0; q < nphi; ++q) {
+          const float wgt = static_cast<float>(mu * dmu * 2.0 * kPi / s_.nphi);
+          const float* v = &L[Cell(0, si, k, q) * nw_];
+          for (size_t w = 0; w < nw_; ++w) (*E)[si * nw_ + w] += wgt * v[w];
+        }
+      }
+    }
+  };
+  auto interp_E = [&](const std::vector<float>& E, double theta_s, float* out) {
+    if (theta_s > sun_theta_rad_.back()) {
+      std::fill(out, out + nw_, 0.0f);
+      return;
+    }
+    const Lerp l = Locate(sun_theta_rad_, theta_s);
+    for (size_t w = 0; w < nw_; ++w) {
+      out[w] = static_cast<float>(E[l.i * nw_ + w] * (1.0 - l.t) + E[(l.i + 1) * nw_ + w] * l.t);
+    }
+  };
+
+  // --- order 1 (scaled problem) at every node
+  std::vector<float> L(cells * nw_, 0.0f), J(cells * nw_, 0.0f), Lnext(cells * nw_, 0.0f);
+  std::vector<float> E0(ns_ * nw_);  // direct sun at the ground (scaled transmittance)
+  {
+    std::vector<float> tr(nw_);
+    for (size_t si = 0; si < ns_; ++si) {
+      const double mus = std::cos(sun_theta_rad_[si]);
+      SunTransmittance(R, mus, true, tr.data());
+      for (size_t w = 0; w < nw_; ++w) E0[si * nw_ + w] = static_cast<float>(sun_e_[w] * std::max(0.0, mus)) * tr[w];
+    }
+  }
+  auto phase_star = [&](size_t c, double mu, size_t w) {
+    const double g = (mu + 1.0) * 0.5 * (kPhaseGrid - 1);
+    const size_t gi = std::min(static_cast<size_t>(g), static_cast<size_t>(kPhaseGrid - 2));
+    const float t = static_cast<float>(g - static_cast<double>(gi));
+    const float a = phase_star_[(c * kPhaseGrid + gi) * nw_ + w], b = phase_star_[(c * kPhaseGrid + gi + 1) * nw_ + w];
+    return a + (b - a) * t;
+  };
+  ReportProgress(progress, "orders: order 1", 0.0);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nr * ns_ * nu_, 4), [&](const tbb::blocked_range<size_t>& rg) {
+    std::vector<float> tsun(nw_), ssc(nw_), src(nw_), acc(nw_), pc(nc_ * nw_), eg(nw_);
+    for (size_t idx = rg.begin(); idx != rg.end(); ++idx) {
+      const size_t ri = idx / (ns_ * nu_), si = (idx / nu_) % ns_, k = idx % nu_;
+      const Family& f = fam[ri * nu_ + k];
+      const double r = radius_[ri], ts = sun_theta_rad_[si];
+      for (size_t q = 0; q < nphi; ++q) {
+        double mu, nu;
+        cell_geometry(ri, si, k, q, &mu, &nu);
+        for (size_t c = 0; c < nc_; ++c) {
+          for (size_t w = 0; w < nw_; ++w) pc[c * nw_ + w] = phase_star(c, nu, w);
+        }
+        std::fill(acc.begin(), acc.end(), 0.0f);
+        for (size_t m = 0; m < f.t.size(); ++m) {
+          const double mus = (r * std::cos(ts) + f.t[m] * nu) / f.r[m];
+          SunTransmittance(f.r[m], mus, true, tsun.data());
+          std::fill(src.begin(), src.end(), 0.0f);
+          for (size_t c = 0; c < nc_; ++c) {
+            SigmaS(c, f.r[m] - R, true, ssc.data());
+            for (size_t w = 0; w < nw_; ++w) src[w] += ssc[w] * pc[c * nw_ + w];
+          }
+          const float dt = static_cast<float>(f.dt[m]);
+          for (size_t w = 0; w < nw_; ++w) acc[w] += f.trans[m * nw_ + w] * src[w] * tsun[w] * static_cast<float>(sun_e_[w]) * dt;
+        }
+        if (f.ground) {
+          const double mus_g = (r * std::cos(ts) + f.d * nu) / R;
+          interp_E(E0, std::acos(std::clamp(mus_g, -1.0, 1.0)), eg.data());
+          for (size_t w = 0; w < nw_; ++w) acc[w] += f.trans_end[w] * static_cast<float>(albedo_[w] / kPi) * eg[w];
+        }
+        std::copy(acc.begin(), acc.end(), &L[Cell(ri, si, k, q) * nw_]);
+      }
+    }
+  });
+
+  // --- orders 2, 3, ...
+  ms_.assign(ns_ * nu_ * nphi * nw_, 0.0f);
+  const size_t nd = nu_ * nphi;  // directions per (radius, sun)
+  std::vector<float> E(ns_ * nw_);
+  double prev_norm = 0.0, prev_ratio = -1.0;
+  const size_t wref = nw_ / 2;
+  for (int order = 2; order <= s_.max_orders; ++order) {
+    ReportProgress(progress, fmt::format("orders: order {}", order), 0.0);
+    // J_n = sum_c sigma_s*_c P*_c applied to L_{n-1}, per radius: a (nd x nd) kernel per wavelength.
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nr, 1), [&](const tbb::blocked_range<size_t>& rg) {
+      std::vector<float> kernel(nd * nd * nw_), mix(static_cast<size_t>(kPhaseGrid) * nw_), ssc(nw_);
+      for (size_t ri = rg.begin(); ri != rg.end(); ++ri) {
+        const double r = radius_[ri];
+        // The mixture phase x scattering coefficient on the cos grid at this radius.
+        std::fill(mix.begin(), mix.end(), 0.0f);
+        for (size_t c = 0; c < nc_; ++c) {
+          SigmaS(c, r - R, true, ssc.data());
+          for (int g = 0; g < kPhaseGrid; ++g) {
+            for (size_t w = 0; w < nw_; ++w) mix[static_cast<size_t>(g) * nw_ + w] += ssc[w] * phase_star_[(c * kPhaseGrid + static_cast<size_t>(g)) * nw_ + w];
+          }
+        }
+        auto mix_at = [&](double mu, float scale, float* out) {
+          const double g = (std::clamp(mu, -1.0, 1.0) + 1.0) * 0.5 * (kPhaseGrid - 1);
+          const size_t gi = std::min(static_cast<size_t>(g), static_cast<size_t>(kPhaseGrid - 2));
+          const float t = static_cast<float>(g - static_cast<double>(gi));
+          const float* a = &mix[gi * nw_];
+          const float* b = &mix[(gi + 1) * nw_];
+          for (size_t w = 0; w < nw_; ++w) out[w] += scale * (a[w] + (b[w] - a[w]) * t);
+        };
+        std::fill(kernel.begin(), kernel.end(), 0.0f);
+        for (size_t i = 0; i < nd; ++i) {
+          const size_t k = i / nphi, q = i % nphi;
+          const double mu = ViewMu(k, r), phi = (q + 0.5) * kPi / s_.nphi;
+          const double sn = std::sqrt(std::max(0.0, 1.0 - mu * mu));
+          for (size_t j = 0; j < nd; ++j) {
+            const size_t k2 = j / nphi, q2 = j % nphi;
+            const double mu2 = ViewMu(k2, r), phi2 = (q2 + 0.5) * kPi / s_.nphi;
+            const double sn2 = std::sqrt(std::max(0.0, 1.0 - mu2 * mu2));
+            const float wgt = static_cast<float>(ViewWidth(k2, r) * kPi / s_.nphi);
+            float* out = &kernel[(i * nd + j) * nw_];
+            mix_at(mu * mu2 + sn * sn2 * std::cos(phi - phi2), wgt, out);
+            mix_at(mu * mu2 + sn * sn2 * std::cos(phi + phi2), wgt, out);
+          }
+        }
+        for (size_t si = 0; si < ns_; ++si) {
+          for (size_t i = 0; i < nd; ++i) {
+            float* jo = &J[(((ri * ns_ + si) * nd) + i) * nw_];
+            std::fill(jo, jo + nw_, 0.0f);
+            for (size_t j = 0; j < nd; ++j) {
+              const float* kv = &kernel[(i * nd + j) * nw_];
+              const float* lv = &L[(((ri * ns_ + si) * nd) + j) * nw_];
+              for (size_t w = 0; w < nw_; ++w) jo[w] += kv[w] * lv[w];
+            }
+          }
+        }
+      }
+    });
+    ground_irradiance(L, &E);
+    // L_n = int T* J_n dt + ground reflection of E_{n-1}.
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nr * ns_ * nu_, 4), [&](const tbb::blocked_range<size_t>& rg) {
+      std::vector<float> acc(nw_), jv(nw_), eg(nw_);
+      for (size_t idx = rg.begin(); idx != rg.end(); ++idx) {
+        const size_t ri = idx / (ns_ * nu_), si = (idx / nu_) % ns_, k = idx % nu_;
+        const Family& f = fam[ri * nu_ + k];
+        const double r = radius_[ri], ts = sun_theta_rad_[si];
+        for (size_t q = 0; q < nphi; ++q) {
+          double mu, nu;
+          cell_geometry(ri, si, k, q, &mu, &nu);
+          std::fill(acc.begin(), acc.end(), 0.0f);
+          for (size_t m = 0; m < f.t.size(); ++m) {
+            const double mus = std::clamp((r * std::cos(ts) + f.t[m] * nu) / f.r[m], -1.0, 1.0);
+            const double mu2 = f.mu[m];
+            const double denom = std::sqrt(std::max(1e-12, (1.0 - mu2 * mu2) * (1.0 - mus * mus)));
+            const double cphi = (nu - mu2 * mus) / denom;
+            std::fill(jv.begin(), jv.end(), 0.0f);
+            Interpolate(J, f.r[m], std::acos(mus), mu2, cphi, f.dt[m], jv.data());
+            for (size_t w = 0; w < nw_; ++w) acc[w] += f.trans[m * nw_ + w] * jv[w];
+          }
+          if (f.ground) {
+            const double mus_g = (r * std::cos(ts) + f.d * nu) / R;
+            interp_E(E, std::acos(std::clamp(mus_g, -1.0, 1.0)), eg.data());
+            for (size_t w = 0; w < nw_; ++w) acc[w] += f.trans_end[w] * static_cast<float>(albedo_[w] / kPi) * eg[w];
+          }
+          std::copy(acc.begin(), acc.end(), &Lnext[Cell(ri, si, k, q) * nw_]);
+        }
+      }
+    });
+    std::swap(L, Lnext);
+    // Accumulate at the observer radius; convergence on the reference wavelength.
+    double norm = 0.0, total = 0.0;
+    for (size_t si = 0; si < ns_; ++si) {
+      for (size_t i = 0; i < nd; ++i) {
+        const float* v = &L[(((obs_index_ * ns_ + si) * nd) + i) * nw_];
+        float* a = &ms_[((si * nd) + i) * nw_];
+        for (size_t w = 0; w < nw_; ++w) a[w] += v[w];
+        norm += v[wref];
+        total += a[wref];
+      }
+    }
+    orders_done_ = order;
+    last_fraction_ = total > 0.0 ? norm / total : 0.0;
+    const double ratio = prev_norm > 0.0 ? norm / prev_norm : -1.0;
+    if (last_fraction_ < s_.tolerance) break;
+    if (order == s_.max_orders && ratio > 0.0 && ratio < 1.0 && prev_ratio > 0.0 && std::abs(ratio - prev_ratio) < 0.02) {
+      // Geometric tail: sum_{k>n} L_k ~ L_n rho / (1 - rho).
+      const float tail = static_cast<float>(ratio / (1.0 - ratio));
+      for (size_t si = 0; si < ns_; ++si) {
+        for (size_t i = 0; i < nd; ++i) {
+          const float* v = &L[(((obs_index_ * ns_ + si) * nd) + i) * nw_];
+          float* a = &ms_[((si * nd) + i) * nw_];
+          for (size_t w = 0; w < nw_; ++w) a[w] += tail * v[w];
+        }
+      }
+      tail_ = true;
+    }
+    prev_ratio = ratio;
+    prev_norm = norm;
+  }
+}
+
+// ---------------------------------------------------------------------------- output
+
+void OrdersMethod::Radiance(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,
+                            std::vector<double>* out) const {
+  const double R = m_.bottom_radius_m, top = m_.top_radius_m;
+  const double r = R + observer_altitude_m;
+  const double ts = sun_zenith_rad;
+  out->assign(dirs.size() * nw_, 0.0);
+  const size_t nd = nu_ * static_cast<size_t>(s_.nphi);
+  // Log-linear interpolation of the MS table in the sun angle (exact for exponential twilight decay).
+  const Lerp ls = Locate(sun_theta_rad_, ts);
+  std::vector<float> tsun(nw_), ssc(nw_), st(nw_), acc(nw_), ms0(nw_), ms1(nw_), pc(nc_ * nw_);
+  std::vector<double> tau(nw_);
+  for (size_t d = 0; d < dirs.size(); ++d) {
+    const double mu = std::clamp(dirs[d][2], -1.0, 1.0);
+    const double sn = std::sqrt(std::max(0.0, 1.0 - mu * mu));
+    const double cphi = sn > 1e-12 ? dirs[d][0] / sn : 1.0;
+    const double nu = dirs[d][0] * std::sin(ts) + mu * std::cos(ts);  // the sun is (sin ts, 0, cos ts)
+    // --- single scattering along the view ray (unscaled medium, full phase)
+    for (size_t c = 0; c < nc_; ++c) {
+      for (size_t w = 0; w < nw_; ++w) pc[c * nw_ + w] = static_cast<float>(phase_[c]->Eval(w, nu));
+    }
+    const double disc_g = r * r * (mu * mu - 1.0) + R * R;
+    const bool ground = mu < 0.0 && disc_g >= 0.0;
+    const double length = ground ? -r * mu - std::sqrt(std::max(0.0, disc_g))
+                                 : -r * mu + std::sqrt(std::max(0.0, r * r * (mu * mu - 1.0) + top * top));
+    std::fill(acc.begin(), acc.end(), 0.0f);
+    std::fill(tau.begin(), tau.end(), 0.0);
+    if (length > 0.0) {
+      // Steps uniform in t^(1/2)... spaced by the parameter s = (tau_ref/tau_tot + t/length)/2
+      // computed on a fine uniform sub-grid at the middle wavelength (as the table rays).
+      const int nf = s_.fine;
+      std::vector<double> cum(static_cast<size_t>(nf) + 1, 0.0);
+      const size_t wref = nw_ / 2;
+      for (int p = 0; p < nf; ++p) {
+        const double tm = (p + 0.5) * length / nf;
+        const double rr = std::sqrt(r * r + 2.0 * r * mu * tm + tm * tm);
+        SigmaT(rr - R, false, st.data());
+        cum[static_cast<size_t>(p) + 1] = cum[static_cast<size_t>(p)] + st[wref] * length / nf;
+      }
+      const double tau_tot = std::max(cum.back(), 1e-12);
+      std::vector<double> s_at(static_cast<size_t>(nf) + 1);
+      for (int p = 0; p <= nf; ++p) s_at[static_cast<size_t>(p)] = 0.5 * (cum[static_cast<size_t>(p)] / tau_tot + static_cast<double>(p) / nf);
+      auto t_of_s = [&](double sv) {
+        const Lerp l = Locate(s_at, sv);
+        return (static_cast<double>(l.i) + l.t) * length / nf;
+      };
+      // Gauss-Legendre (2 points) on each step; optical depth accumulated with the same rule.
+      static const double kG = 0.5773502691896257;
+      double t_prev = 0.0;
+      for (int m = 0; m < s_.nss; ++m) {
+        const double t0 = t_of_s(static_cast<double>(m) / s_.nss), t1 = t_of_s(static_cast<double>(m + 1) / s_.nss);
+        const double h = t1 - t0;
+        for (double g : {-kG, kG}) {
+          const double t = 0.5 * (t0 + t1) + 0.5 * g * h;
+          const double rr = std::sqrt(r * r + 2.0 * r * mu * t + t * t);
+          // Optical depth from the observer to t: advance from t_prev with the midpoint value.
+          const double tmid = 0.5 * (t_prev + t);
+          const double rmid = std::sqrt(r * r + 2.0 * r * mu * tmid + tmid * tmid);
+          SigmaT(rmid - R, false, st.data());
+          for (size_t w = 0; w < nw_; ++w) tau[w] += st[w] * (t - t_prev);
+          t_prev = t;
+          const double mus = (r * std::cos(ts) + t * nu) / rr;
+          SunTransmittance(rr, mus, false, tsun.data());
+          for (size_t w = 0; w < nw_; ++w) ssc[w] = 0.0f;
+          for (size_t c = 0; c < nc_; ++c) {
+            SigmaS(c, rr - R, false, st.data());
+            for (size_t w = 0; w < nw_; ++w) ssc[w] += st[w] * pc[c * nw_ + w];
+          }
+          const float hw = static_cast<float>(0.5 * h);
+          for (size_t w = 0; w < nw_; ++w) {
+            acc[w] += hw * static_cast<float>(std::exp(-tau[w])) * ssc[w] * tsun[w] * static_cast<float>(sun_e_[w]);
+          }
+        }
+      }
+      if (ground) {
+        // Finish the optical depth to the ground and add the ground's first reflection.
+        const double tmid = 0.5 * (t_prev + length);
+        const double rmid = std::sqrt(r * r + 2.0 * r * mu * tmid + tmid * tmid);
+        SigmaT(rmid - R, false, st.data());
+        for (size_t w = 0; w < nw_; ++w) tau[w] += st[w] * (length - t_prev);
+      }
+    }
+    if (ground) {
+      const double mus_g = (r * std::cos(ts) + std::max(0.0, length) * nu) / R;
+      if (mus_g > -0.5) {
+        SunTransmittance(R, mus_g, false, tsun.data());
+        for (size_t w = 0; w < nw_; ++w) {
+          acc[w] += static_cast<float>(std::exp(-tau[w]) * albedo_[w] / kPi * sun_e_[w] * std::max(0.0, mus_g)) * tsun[w];
+        }
+      }
+    }
+    // --- multiple scattering from the table at the observer radius
+    std::fill(ms0.begin(), ms0.end(), 0.0f);
+    std::fill(ms1.begin(), ms1.end(), 0.0f);
+    if (ts <= sun_theta_rad_.back()) {
+      size_t k0, k1;
+      double tk;
+      ViewIndex(mu, r, &k0, &k1, &tk);
+      double fq = std::acos(std::clamp(cphi, -1.0, 1.0)) / kPi * s_.nphi - 0.5;
+      fq = std::clamp(fq, 0.0, static_cast<double>(s_.nphi - 1));
+      const size_t q0 = std::min(static_cast<size_t>(fq), static_cast<size_t>(s_.nphi - 2));
+      const double tq = fq - static_cast<double>(q0);
+      for (int ds = 0; ds < 2; ++ds) {
+        float* dst = ds ? ms1.data() : ms0.data();
+        const size_t si = ls.i + static_cast<size_t>(ds);
+        for (int dk = 0; dk < 2; ++dk) {
+          for (int dq = 0; dq < 2; ++dq) {
+            const float wgt = static_cast<float>((dk ? tk : 1.0 - tk) * (dq ? tq : 1.0 - tq));
+            const float* v = &ms_[((si * nd) + (dk ? k1 : k0) * static_cast<size_t>(s_.nphi) + q0 + static_cast<size_t>(dq)) * nw_];
+            for (size_t w = 0; w < nw_; ++w) dst[w] += wgt * v[w];
+          }
+        }
+      }
+    }
+    for (size_t w = 0; w < nw_; ++w) {
+      double ms;
+      const double a = ms0[w], b = ms1[w];
+      if (a > 0.0 && b > 0.0) ms = std::exp(std::log(a) + (std::log(b) - std::log(a)) * ls.t);
+      else ms = a + (b - a) * ls.t;
+      (*out)[d * nw_ + w] = acc[w] + std::max(0.0, ms);
+    }
+  }
+}
+
+}  // namespace
+
+std::unique_ptr<SkyMethod> MakeOrdersMethod(const AtmosphereModel& model, const SkyMethodOptions& options,
+                                            const ProgressFn& progress) {
+  return std::make_unique<OrdersMethod>(model, options, progress);
+}
+
+}  // namespace skybake
