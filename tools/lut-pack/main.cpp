@@ -1,7 +1,7 @@
 // lut-pack: GT7 adaptive sky LUTs and the other runtime textures from sky-render products
 // (docs/lut-pack.md).
 //
-//   lut-pack pack NAME=SKY.exr ... -o OUT/report.json [--sky-exposure-stops 0] [--budget-mib 3.5]
+//   lut-pack pack NAME=SKY.exr ... -o OUT/report.json [--sky-exposure-stops auto|N] [--budget-mib 3.5]
 //            [--night-end-zenith-deg 108] [--ocio-config config.ocio] [--depfile OUT/report.json.d]
 //       SKY.exr: sky-render render --mapping gt7 --time-mapping gt7 --size WxH (one per basis sky);
 //       writes OUT/sky_<NAME>.{ktx2,_array.ktx2,dds,exr}, OUT/{transmittance,sun,ambient}.{ktx2,dds},
@@ -11,6 +11,7 @@
 //       directions and reports the luminance error.
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <filesystem>
 #include <set>
 
@@ -54,13 +55,15 @@ int main(int argc, char** argv) {
 
   CLI::App* pack = cli.app().add_subcommand("pack", "Pack the basis skies of one set (one NAME=render.exr per sky)");
   std::vector<std::string> inputs;
-  double exposure_stops = 0.0, budget_mib = 3.5, night_end_deg = 108.0;
+  std::string exposure_stops = "auto";
+  double budget_mib = 3.5, night_end_deg = 108.0;
   pack->add_option("skies", inputs, "NAME=SKY.exr: a basis sky's name and its sky-render render (--mapping gt7 --time-mapping gt7)")
       ->required();
   pack->add_option("-o,--output", output, "The report (JSON); the textures are written beside it")->required();
   pack->add_option("--sky-exposure-stops", exposure_stops,
-                   "Sky texels store cd/m^2 x 2^stops (0: cd/m^2 as is; docs/lut-pack.md 'Scale')")
-      ->default_val(0.0)->check(CLI::Range(-24.0, 24.0));
+                   "Sky texels store cd/m^2 x 2^N; auto: per texture the largest 2^-k (k >= 0) with which nothing clamps "
+                   "(docs/lut-pack.md 'Scale')")
+      ->default_val("auto");
   pack->add_option("--budget-mib", budget_mib, "Fail when the sky LUTs' texels exceed this many MiB (GT7: 3.5)")
       ->default_val(3.5)->check(CLI::PositiveNumber);
   pack->add_option("--night-end-zenith-deg", night_end_deg, "Sun zenith angle where the sky reaches its night constant")
@@ -108,8 +111,15 @@ int main(int argc, char** argv) {
       std::vector<std::pair<std::string, const lut::SkyRender*>> set_in;
       for (size_t i = 0; i < named.size(); ++i) set_in.emplace_back(named[i].first, &renders[i]);
       lut::LutSetOptions opt;
-      if (exposure_stops != std::round(exposure_stops)) throw UsageError("--sky-exposure-stops: expected a whole number of stops");
-      opt.sky_scale = std::ldexp(1.0, static_cast<int>(exposure_stops));
+      if (exposure_stops != "auto") {
+        int stops = 0;
+        auto [end, ec] = std::from_chars(exposure_stops.data(), exposure_stops.data() + exposure_stops.size(), stops);
+        if (ec != std::errc() || end != exposure_stops.data() + exposure_stops.size() || stops < -24 || stops > 24) {
+          throw UsageError("--sky-exposure-stops: expected auto or a whole number of stops from -24 to 24, got '" +
+                           exposure_stops + "'");
+        }
+        opt.sky_scale = std::ldexp(1.0, stops);
+      }
       opt.night_end_zenith_deg = night_end_deg;
       const lut::LutSet set = lut::BuildLutSet(set_in, opt, config, &files_read);
       {  // each file once, in first-read order (the CMF table is read once per basis sky)
@@ -131,7 +141,7 @@ int main(int argc, char** argv) {
       Provenance prov;
       prov.tool = cli.name();
       std::string params = fmt::format("sky_exposure_stops: {}\nbudget_mib: {}\nnight_end_zenith_deg: {}\nskies:\n",
-                                       FormatExact(exposure_stops), FormatExact(budget_mib), FormatExact(night_end_deg));
+                                       exposure_stops, FormatExact(budget_mib), FormatExact(night_end_deg));
       for (const auto& [name, path] : named) params += "  - " + name + "\n";
       prov.parameters = params;
       for (const fs::path& f : files_read) prov.AddInput(f);
@@ -139,7 +149,7 @@ int main(int argc, char** argv) {
       for (const auto& [name, path] : named) {
         Provenance& sp = sky_prov[name];
         sp.tool = prov.tool;
-        sp.parameters = fmt::format("sky_exposure_stops: {}\nnight_end_zenith_deg: {}\nbasis_sky: {}\n", FormatExact(exposure_stops),
+        sp.parameters = fmt::format("sky_exposure_stops: {}\nnight_end_zenith_deg: {}\nbasis_sky: {}\n", exposure_stops,
                                     FormatExact(night_end_deg), name);
         sp.AddInput(path);
         for (size_t i = named.size(); i < files_read.size(); ++i) sp.AddInput(files_read[i]);  // OCIO config, CMFs

@@ -9,7 +9,7 @@
 //     method: orders               # sky-render method of the LUT renders (docs/sky-methods.md)
 //     quality: medium              # its quality preset
 //     time_mapping: gt7-quadratic  # or gt7 (the talk's; docs/lut-pack.md), optionally ":<upper>+<lower>"
-//     sky_exposure_stops: 0        # sky texels store cd/m^2 x 2^stops
+//     sky_exposure_stops: auto     # or N: sky texels store cd/m^2 x 2^N (auto: per texture, no clamping)
 //     budget_mib: 3.5              # lut-pack fails when the sky LUTs exceed it
 //     skies:                       # the basis skies of the set, in row order of the other LUTs
 //       - {atmosphere: clear, size: 32x128}
@@ -54,7 +54,17 @@ class LutPackStage : public Stage {
         }
       }
     }
-    exposure_stops_ = luts->NumberOr("sky_exposure_stops", NumberSpec::Range(-24, 24, "stops"), exposure_stops_);
+    if (std::optional<YamlNode> e = luts->Get("sky_exposure_stops")) {
+      const std::optional<std::string> text = e->ToString("auto or a whole number of stops from -24 to 24");
+      int stops = 0;
+      char tail = 0;
+      if (text && *text != "auto" &&
+          (std::sscanf(text->c_str(), "%d%c", &stops, &tail) != 1 || stops < -24 || stops > 24 || *text != std::to_string(stops))) {
+        e->ErrorExpected("auto or a whole number of stops from -24 to 24");
+      } else if (text) {
+        exposure_stops_ = *text;
+      }
+    }
     budget_mib_ = luts->NumberOr("budget_mib", NumberSpec::Positive("MiB"), budget_mib_);
     std::set<std::string> seen;
     for (const YamlNode& n : luts->Seq("skies")) {
@@ -140,7 +150,7 @@ class LutPackStage : public Stage {
     b.rule = "lut_pack";
     b.implicit_inputs = {ctx.ToolPath(tool())};
     b.variables = {{"skies", skies},
-                   {"args", fmt::format("--sky-exposure-stops {} --budget-mib {}", FormatExact(exposure_stops_),
+                   {"args", fmt::format("--sky-exposure-stops {} --budget-mib {}", exposure_stops_,
                                         FormatExact(budget_mib_))}};
     ctx.Build(tool(), b);
   }
@@ -162,7 +172,7 @@ class LutPackStage : public Stage {
   std::string method_ = "orders";
   std::string quality_ = "medium";
   std::string time_mapping_ = "gt7-quadratic";
-  double exposure_stops_ = 0.0;
+  std::string exposure_stops_ = "auto";
   double budget_mib_ = 3.5;
   std::vector<LutSky> skies_;
 };

@@ -303,7 +303,7 @@ LutSet BuildLutSet(const std::vector<std::pair<std::string, const SkyRender*>>& 
     rgb.reserve(static_cast<size_t>(r->width) * r->height * slices * 3);
     for (const std::vector<float>& s : r->slice_xyz) rgb.insert(rgb.end(), s.begin(), s.end());
     to2020.Apply(rgb);
-    p.sky = PackRgb(r->width, r->height, slices, rgb, options.sky_scale, to_xyz);
+    p.sky = PackRgb(r->width, r->height, slices, rgb, options.sky_scale > 0.0 ? options.sky_scale : AutomaticScale(rgb), to_xyz);
 
     std::vector<float> sun, amb;
     for (int k = 0; k < slices; ++k) {

@@ -101,7 +101,9 @@ double AutomaticScale(const std::vector<float>& rgb_physical);
 
 // What lut-pack builds from a set of renders.
 struct LutSetOptions {
-  double sky_scale = 1.0;  // stored sky value = cd/m^2 x sky_scale (docs/lut-pack.md, "Scale")
+  // Stored sky value = cd/m^2 x scale (docs/lut-pack.md, "Scale"): a fixed scale, or (0) per
+  // texture the largest 2^-k, k >= 0, with which no texel clamps (AutomaticScale).
+  double sky_scale = 0.0;
   double night_end_zenith_deg = 108.0;  // below -10 deg the sky fades to its night constant by here
 };
 
