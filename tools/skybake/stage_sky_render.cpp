@@ -14,8 +14,10 @@
 //     sun_zenith_deg: [30, 70, 85, 90, 94]
 //     target_error: 0.05           # relative standard error of Y per texel
 //     preview: true
+//     atmospheres: [clear, hazed]  # optional: only these get a reference render (default: all)
 #include <fmt/format.h>
 
+#include <map>
 #include <set>
 
 #include "atmosphere/spec.h"
@@ -46,6 +48,15 @@ class SkyRenderStage : public Stage {
     if (sky->Has("sun_zenith_deg")) sun_zenith_deg_ = sky->NumberList("sun_zenith_deg", NumberSpec::Range(0, 180, "degrees"));
     target_error_ = sky->NumberOr("target_error", NumberSpec::Range(1e-4, 1.0, ""), target_error_);
     preview_ = sky->BoolOr("preview", preview_);
+    if (std::optional<std::vector<YamlNode>> only = sky->OptionalSeq("atmospheres")) {
+      only_.emplace();
+      for (const YamlNode& n : *only) {
+        if (std::optional<std::string> name = n.ToString("an atmosphere name")) {
+          only_->insert(*name);
+          only_loc_[*name] = n.loc();
+        }
+      }
+    }
     sky->Finish();
   }
 
@@ -56,11 +67,17 @@ class SkyRenderStage : public Stage {
 
   void EmitEdges(GenContext& ctx) const override {
     const auto& wl = ctx.pipeline().wavelengths;
+    for (const auto& [name, loc] : only_loc_) {
+      bool known = false;
+      for (const PipelineAtmosphere& a : ctx.pipeline().atmospheres) known = known || a.name == name;
+      if (!known) throw InputError(loc, "sky.atmospheres: '" + name + "' is not an atmosphere of this pipeline");
+    }
     std::string zeniths;
     for (double z : sun_zenith_deg_) zeniths += (zeniths.empty() ? "" : ",") + FormatExact(z);
     for (const PipelineAtmosphere& a : ctx.pipeline().atmospheres) {
       const std::filesystem::path comp_rel = paths::RenderComponent(a.name);
       ctx.WriteComponent(comp_rel, CanonicalRenderYaml(a.spec, (ctx.pipeline().out_dir / comp_rel).parent_path()));
+      if (only_ && !only_->count(a.name)) continue;  // the component is still written: other renderers use it
       NinjaBuild b;
       b.outputs = {paths::Sky(a.name).generic_string()};
       if (preview_) b.implicit_outputs = {paths::SkyPreview(a.name).generic_string()};
@@ -90,6 +107,8 @@ class SkyRenderStage : public Stage {
   std::vector<double> sun_zenith_deg_ = {30, 70, 85, 90, 94};
   double target_error_ = 0.05;
   bool preview_ = true;
+  std::optional<std::set<std::string>> only_;  // sky.atmospheres
+  std::map<std::string, FileLoc> only_loc_;
 };
 
 }  // namespace
