@@ -129,30 +129,32 @@ MultipleScatteringLut::MultipleScatteringLut(const SingleScatteringModel& ss, co
 }
 
 void MultipleScatteringLut::Psi(double z, double mu_s, double* psi) const {
+  std::fill(psi, psi + nw_, 0.0);
+  std::vector<double> one(nw_, 1.0);
+  Accumulate(z, mu_s, one.data(), psi);
+}
+
+// dst[wl] += scale[wl] * Psi(z, mu_s)[wl] (bilinear in the node values).
+void MultipleScatteringLut::Accumulate(double z, double mu_s, const double* scale, double* dst) const {
   const double fz = std::clamp(z / top_, 0.0, 1.0) * (s_.lut_z - 1);
   const double fm = std::clamp(0.5 * (mu_s + 1.0), 0.0, 1.0) * (s_.lut_mu_s - 1);
   const int iz = std::min(static_cast<int>(fz), s_.lut_z - 2), im = std::min(static_cast<int>(fm), s_.lut_mu_s - 2);
   const double tz = fz - iz, tm = fm - im;
+  const double w00 = (1 - tz) * (1 - tm), w01 = (1 - tz) * tm, w10 = tz * (1 - tm), w11 = tz * tm;
   const double* a = &psi_[(static_cast<size_t>(iz) * s_.lut_mu_s + im) * nw_];
   const double* b = a + nw_;
   const double* c = a + static_cast<size_t>(s_.lut_mu_s) * nw_;
   const double* d = c + nw_;
-  for (size_t w = 0; w < nw_; ++w) {
-    psi[w] = (1 - tz) * ((1 - tm) * a[w] + tm * b[w]) + tz * ((1 - tm) * c[w] + tm * d[w]);
-  }
+  for (size_t w = 0; w < nw_; ++w) dst[w] += scale[w] * (w00 * a[w] + w01 * b[w] + w10 * c[w] + w11 * d[w]);
 }
 
 void MultipleScatteringLut::Add(double z, double mu_sun, const double* sigma_s, double* src) const {
-  double psi[64];
-  std::vector<double> big;
-  double* p = psi;
-  if (nw_ > 64) {
-    big.resize(nw_);
-    p = big.data();
-  }
-  Psi(z, mu_sun, p);
+  // source += sigma_s Psi_ms E_0 (Hillaire 2020 eq. 11), E_0 folded into the scale.
   const std::vector<double>& e0 = ss_.model().sun.irradiance;
-  for (size_t w = 0; w < nw_; ++w) src[w] += sigma_s[w] * p[w] * e0[w];
+  thread_local std::vector<double> scale;
+  scale.resize(nw_);
+  for (size_t w = 0; w < nw_; ++w) scale[w] = sigma_s[w] * e0[w];
+  Accumulate(z, mu_sun, scale.data(), src);
 }
 
 namespace {

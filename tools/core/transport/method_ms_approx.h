@@ -67,6 +67,7 @@ class MultipleScatteringLut : public SingleScatteringModel::ExtraSource {
   void Add(double z_m, double mu_sun, const double* sigma_s, double* src) const override;
 
  private:
+  void Accumulate(double z_m, double mu_s, const double* scale, double* dst) const;
   const SingleScatteringModel& ss_;
   MsApproxSettings s_;
   size_t nw_;

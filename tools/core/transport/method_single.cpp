@@ -221,6 +221,14 @@ RayExtent ExtentOf(const AtmosphereModel& m, const glm::dvec3& x, const glm::dve
 
 // ---------------------------------------------------------------------------- the march
 
+namespace {
+std::vector<double> Ladder(double top, double dz_min, double dz_rel) {
+  std::vector<double> z;
+  for (double a = 0.0; a < top; a += std::max(dz_min, dz_rel * a)) z.push_back(a);
+  return z;
+}
+}  // namespace
+
 SingleScatteringModel::SingleScatteringModel(const AtmosphereModel& model, const MarchSettings& s)
     : model_(model),
       settings_(s),
@@ -230,15 +238,8 @@ SingleScatteringModel::SingleScatteringModel(const AtmosphereModel& model, const
   SKYBAKE_CHECK_GT(s.dz_min_m, 0.0);
   SKYBAKE_CHECK_GE(s.dz_rel, 0.0);
   SKYBAKE_CHECK_GT(s.max_piece_m, 0.0);
+  ladder_ = Ladder(model.altitude_m.back(), s.dz_min_m, s.dz_rel);
 }
-
-namespace {
-std::vector<double> Ladder(double top, double dz_min, double dz_rel) {
-  std::vector<double> z;
-  for (double a = 0.0; a < top; a += std::max(dz_min, dz_rel * a)) z.push_back(a);
-  return z;
-}
-}  // namespace
 
 std::vector<double> SingleScatteringModel::Nodes(const glm::dvec3& x, const glm::dvec3& v,
                                                  const std::vector<glm::dvec3>& sun_dirs, double length,
@@ -256,7 +257,9 @@ std::vector<double> SingleScatteringModel::Nodes(const glm::dvec3& x, const glm:
     if (tt > 0.0 && tt < length) t.push_back(tt);
   };
   // Altitude ladder crossings (both sides of the closest approach).
-  for (double z : Ladder(model_.altitude_m.back(), dz_min, dz_rel)) {
+  const bool own = o.dz_min_m > 0 || o.dz_rel > 0;
+  const std::vector<double> custom = own ? Ladder(model_.altitude_m.back(), dz_min, dz_rel) : std::vector<double>{};
+  for (double z : own ? custom : ladder_) {
     const double rho = R + z;
     const double q = rho * rho - p2;
     if (q < 0.0) continue;
