@@ -92,6 +92,7 @@ def main():
     ap.add_argument("--skies", default="clear,hazed")
     ap.add_argument("--slices", default="0,1,5,10,16,23,30,40,46,48,52,56,60,62")
     ap.add_argument("--no-blend", action="store_true")
+    ap.add_argument("--no-decode", action="store_true")
     a = ap.parse_args()
     os.makedirs(a.work, exist_ok=True)
     with open(os.path.join(a.luts, "report.json")) as f:
@@ -120,7 +121,7 @@ def main():
     zeniths = [mid_zenith(report, i) for i in slices]
     renders = {s["name"]: s["render"] for s in report["skies"]}
     print("\n== decode vs direct render half-way between slices (%s %s, upper hemisphere) ==" % (a.method, a.quality))
-    for sky in a.skies.split(","):
+    for sky in ([] if a.no_decode else a.skies.split(",")):
         atm = os.path.join(ROOT, "atmospheres", sky + ".yaml")
         direct = os.path.join(a.work, "direct_%s.exr" % sky)
         render_direct(a.bin, atm, direct, zeniths, a)
@@ -154,11 +155,12 @@ def main():
     # EXRs' G channel, read with oiiotool), solid-angle weighted over the upper hemisphere.
     ya = luminance_rms(os.path.join(a.work, "blend_clear.exr"), os.path.join(a.work, "blend_hazed.exr"),
                        os.path.join(a.work, "direct_mid.exr"), zs, a.work)
-    print("  %-10s %18s %18s" % ("sun zenith", "direct blend rms %", "LUT blend rms %"))
-    for z, s, y in zip(zs, rb["slices"], ya):
-        print("  %-10.1f %18.3f %18.3f   (LUT blend max %+.2f %% at view zenith %.1f, %.1f deg from the sun)" % (
-            z, 100 * y, 100 * s["rms_upper"], 100 * s["max_upper"]["relative_error"], s["max_upper"]["view_zenith_deg"],
-            s["max_upper"]["angle_from_sun_deg"]))
+    print("  the intermediate atmosphere: clear's aerosol at tau 0.05 + hazed's at tau 0.25 (the mean of the fields)")
+    print("  %-10s %14s %14s %12s %14s" % ("sun zenith", "0.5/0.5 rms %", "LUT blend %", "best w_clear", "best-w rms %"))
+    for z, s, (y, w, yw) in zip(zs, rb["slices"], ya):
+        print("  %-10.1f %14.3f %14.3f %12.3f %14.3f   (LUT blend max %+.2f %% at view zenith %.1f, %.1f deg from the sun)" % (
+            z, 100 * y, 100 * s["rms_upper"], w, 100 * yw, 100 * s["max_upper"]["relative_error"],
+            s["max_upper"]["view_zenith_deg"], s["max_upper"]["angle_from_sun_deg"]))
 
 
 def write_mid_atmosphere(path):
@@ -189,19 +191,28 @@ def exr_y(path, part, work):
 
 
 def luminance_rms(a_exr, b_exr, mid_exr, zs, work):
+    """Per sun angle: RMS relative luminance error of 0.5 a + 0.5 b against mid, the weight w of
+    a that minimises it (weighted least squares: e = (w ya + (1 - w) yb - ym) / ym is linear in
+    w) and that minimum, over the upper hemisphere of a 64x32 equirectangular grid, weighted by
+    the texels' solid angles."""
     out = []
     for k in range(len(zs)):
         ya, yb, ym = exr_y(a_exr, k, work), exr_y(b_exr, k, work), exr_y(mid_exr, k, work)
-        s2 = sw = 0.0
+        rows = []
         for t, (x, y, m) in enumerate(zip(ya, yb, ym)):
             row = t // 64
             if row >= 16 or m <= 0:
                 continue  # upper hemisphere only
-            sa = math.cos(math.pi * row / 32) - math.cos(math.pi * (row + 1) / 32)
-            e = (0.5 * (x + y) - m) / m
-            s2 += sa * e * e
-            sw += sa
-        out.append(math.sqrt(s2 / sw))
+            rows.append((math.cos(math.pi * row / 32) - math.cos(math.pi * (row + 1) / 32), x / m, y / m))
+        sw = sum(sa for sa, _, _ in rows)
+
+        def rms(w):
+            return math.sqrt(sum(sa * (w * x + (1 - w) * y - 1) ** 2 for sa, x, y in rows) / sw)
+
+        # e = w (x - y) + (y - 1): minimise sum sa e^2 -> w = -sum sa (x - y)(y - 1) / sum sa (x - y)^2
+        den = sum(sa * (x - y) ** 2 for sa, x, y in rows)
+        w = -sum(sa * (x - y) * (y - 1) for sa, x, y in rows) / den if den > 0 else 0.5
+        out.append((rms(0.5), w, rms(w)))
     return out
 
 

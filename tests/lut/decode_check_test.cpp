@@ -12,7 +12,8 @@
 // measures the mapping + interpolation + packing, which do not depend on the method.
 // Both time mappings are checked: skybake's gt7-quadratic (the default) everywhere, and the talk's
 // gt7 everywhere but its first step (0 -> 35.2 deg), whose measured error is printed and is the
-// reason for the default (docs/lut-pack.md, "Decisions").
+// reason for the default (docs/lut-pack.md, "Decisions"). Deep twilight needs multiple scattering:
+// those pairs use the `orders` method.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -54,10 +55,6 @@ struct Scene {
   AtmosphereSpec spec;
 };
 
-bool HaveMethod(const std::string& name) {
-  const std::vector<std::string> n = SkyMethodNames();
-  return std::find(n.begin(), n.end(), name) != n.end();
-}
 
 // clear.yaml with its OPAC continental aerosol, 400-700 nm in 50 nm steps, CIE 1931 (its XYZ is
 // OCIO's reference space: no observer conversion needed here).
@@ -200,12 +197,11 @@ TEST(DecodeCheck, QuadraticTimeMappingWithinTwoPercentRms) {
 TEST(DecodeCheck, DeepTwilightWithMultipleScattering) {
   // Below -1 deg the single-scattering sky is black in the Earth's shadow and its terminator
   // sweeps across the sky: a method with multiple scattering is needed for a meaningful check.
-  // The geometric time interpolation stays within 2.2 % (measured 1.0-2.2 %); the linear one is
-  // 13-19 % off half-way in deep twilight and is printed for the record.
-  if (!HaveMethod("orders")) GTEST_SKIP() << "the 'orders' method (sky-render part 2) is not built yet";
+  // The geometric time interpolation stays within 2 % (measured 0.8-1.8 %); the linear one is
+  // 15-21 % off half-way in deep twilight and is printed for the record.
   for (int i : {54, 56, 58, 60, 62}) {
     const Figures f = CheckPair("gt7-quadratic", i, "orders");
-    EXPECT_LE(f.rms, 0.025) << "slices " << i << "-" << i + 1;
+    EXPECT_LE(f.rms, 0.02) << "slices " << i << "-" << i + 1;
     CheckPair("gt7-quadratic", i, "orders", lut::TimeInterpolation::kLinear);
   }
 }
@@ -215,7 +211,8 @@ TEST(DecodeCheck, TalksTimeMappingWithinTwoPercentRmsExceptItsFirstStep) {
     const Figures f = CheckPair("gt7", i);
     EXPECT_LE(f.rms, 0.02) << "slices " << i << "-" << i + 1;
   }
-  // The first step, sun zenith 0 -> 35.2 deg, is too wide for linear interpolation in either
-  // frame: ~14 % RMS half-way. Should this ever pass, revisit the gt7-quadratic default.
-  EXPECT_GT(CheckPair("gt7", 0).rms, 0.05);
+  // The first step, sun zenith 0 -> 35.2 deg, is too wide to interpolate in either frame: 3.6 %
+  // RMS half-way with the default blend (14 % with the talk's linear blend in the slice
+  // coordinate). Should this ever pass, revisit the gt7-quadratic default.
+  EXPECT_GT(CheckPair("gt7", 0).rms, 0.02);
 }

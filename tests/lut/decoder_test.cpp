@@ -112,8 +112,9 @@ TEST(Decoder, InterpolationErrorIsSecondOrderInResolution) {
 TEST(Decoder, TimeInterpolationFollowsTheSliceCoordinate) {
   // A uniform sky per slice, g_k = 1 + k^2 / 10 (any values): the decoded sky at any sun angle is
   // g_i^(1 - t) g_(i+1)^t (geometric, the default) or (1 - t) g_i + t g_(i+1) (linear) with
-  // i + t = SliceCoordinate(theta), for every direction - including the pair that straddles the
-  // threshold (read with two families) and the 90 deg pair.
+  // i = floor(SliceCoordinate(theta)) and t linear in theta between the two slice angles, for
+  // every direction - including the pair that straddles the threshold (read with two families)
+  // and the 90 deg pair.
   const gt7::TimeMapping time = Earth();
   const int w = 8, h = 16;
   std::vector<float> rgb;
@@ -125,9 +126,9 @@ TEST(Decoder, TimeInterpolationFollowsTheSliceCoordinate) {
   for (TimeInterpolation mode : {TimeInterpolation::kGeometric, TimeInterpolation::kLinear}) {
     d.set_time_interpolation(mode);
     for (double zd = 0.0; zd <= 100.0; zd += 0.0937) {
-      const double s = time.SliceCoordinate(zd * kDeg);
-      const int i = std::min(static_cast<int>(std::floor(s)), 62);
-      const double t = s - i;
+      const int i = std::min(static_cast<int>(std::floor(time.SliceCoordinate(zd * kDeg))), 62);
+      const double ta = time.SliceZenithRad(i), tb = time.SliceZenithRad(i + 1);
+      const double t = tb > ta ? (zd * kDeg - ta) / (tb - ta) : 0.0;
       const double a = 1.0 + i * i / 10.0, b = 1.0 + (i + 1) * (i + 1) / 10.0;
       const double want = mode == TimeInterpolation::kLinear ? (1 - t) * a + t * b : std::pow(a, 1 - t) * std::pow(b, t);
       for (double z : {5.0, 89.0, 120.0}) {

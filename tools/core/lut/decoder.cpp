@@ -111,9 +111,9 @@ std::array<double, 3> SkyLutDecoder::Radiance(const std::array<double, 3>& d, do
     const std::array<double, 3> last = SliceRadiance(n - 1, d, theta_last);
     return {(1 - f) * last[0] + f * night_[0], (1 - f) * last[1] + f * night_[1], (1 - f) * last[2] + f * night_[2]};
   }
-  const double s = time_.SliceCoordinate(theta);
-  const int i = std::min(static_cast<int>(std::floor(s)), n - 2);
-  const double t = s - i;
+  const int i = std::min(static_cast<int>(std::floor(time_.SliceCoordinate(theta))), n - 2);
+  const double a_rad = time_.SliceZenithRad(i), b_rad = time_.SliceZenithRad(i + 1);
+  const double t = b_rad > a_rad ? std::clamp((theta - a_rad) / (b_rad - a_rad), 0.0, 1.0) : 0.0;
   const std::array<double, 3> a = SliceRadiance(i, d, theta);
   if (t <= 0.0) return a;
   const std::array<double, 3> b = SliceRadiance(i + 1, d, theta);

@@ -409,10 +409,11 @@ ktx2::Texture SkyKtx2(const LutSet& set, const SkyLutProduct& sky, bool array, c
                   fmt::format("{} {} {}", FormatExact(sky.night_rgb[0]), FormatExact(sky.night_rgb[1]), FormatExact(sky.night_rgb[2])));
   ktx2::SetString(tex, "skybake.night_end_zenith_deg", FormatExact(set.options.night_end_zenith_deg));
   ktx2::SetString(tex, "skybake.sampling",
-                  "bilinear filtering, clamp-to-edge in u and v; slice coordinate s of the sun zenith from the time mapping; "
-                  "read slices i = min(floor(s), N - 2) and i + 1, each with its own sphere-mapping family at the target sun "
-                  "zenith (sun-aligned slices at min(target, threshold zenith)), and blend them geometrically per channel, "
-                  "max(a, 1e-6)^(1 - t) max(b, 1e-6)^t with t = s - i (values in cd/m^2; docs/lut-pack.md, 'Decoding')");
+                  "bilinear filtering, clamp-to-edge in u and v; slice coordinate s of the sun zenith theta from the time "
+                  "mapping; read slices i = min(floor(s), N - 2) and i + 1, each with its own sphere-mapping family at the "
+                  "target sun zenith (sun-aligned slices at min(theta, threshold zenith)), and blend them geometrically per "
+                  "channel, max(a, 1e-6)^(1 - t) max(b, 1e-6)^t with t = (theta - theta_i)/(theta_i+1 - theta_i) (values "
+                  "in cd/m^2; docs/lut-pack.md, 'Decoding')");
   ktx2::SetString(tex, "skybake.time_interpolation", "geometric");
   tex.data = sky.sky.bytes;
   return tex;
