@@ -194,7 +194,7 @@ class NoiseGenCli(CliContract, TempDirTestCase):
         self.assertEqual(r.returncode, 1)
         self.assertEqual(r.stderr.splitlines(), [
             "noise-gen: %s:1: key 'resolution': expected an integer from 4 to 256 (texels per side), got \"3\"" % bad,
-            "noise-gen: %s:1: missing key 'normalize': expected one of 'zero_mean' 'min_max' 'none'" % bad,
+            "noise-gen: %s:1: missing key 'normalize': expected one of 'zero_mean', 'min_max' or 'none'" % bad,
             "noise-gen: %s:2: key 'tile_size_km': expected a positive number in km, got \"-1\"" % bad,
             "noise-gen: %s:5: unknown key 'normalise' (did you mean 'normalize'?)" % bad,
             "noise-gen: %s:7: key 'channels[0].perlin.gain': expected a number in (0, 1] (amplitude ratio between octaves), got \"2\"" % bad,

@@ -56,6 +56,9 @@ OrdersSettings SettingsFor(const SkyMethodOptions& o) {
   get("azimuth", &s.nphi);
   get("ray_steps", &s.nt);
   get("view_steps", &s.nss);
+  int trunc = 0;
+  get("truncation_deg", &trunc);
+  if (trunc > 0) s.truncation_deg = trunc;
   if (o.view_steps > 0) s.nss = o.view_steps;
   if (o.orders > 0) s.max_orders = o.orders;
   if (o.order_tolerance > 0) s.tolerance = o.order_tolerance;
@@ -110,7 +113,14 @@ class OrdersMethod : public SkyMethod {
   }
 
   void Radiance(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,
-                std::vector<double>* out) const override;
+                std::vector<double>* out) const override {
+    Render(observer_altitude_m, sun_zenith_rad, dirs, nullptr, out);
+  }
+  bool SupportsSegments() const override { return true; }
+  void SegmentRadiance(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,
+                       const ViewSegment& segment, std::vector<double>* out) const override {
+    Render(observer_altitude_m, sun_zenith_rad, dirs, &segment, out);
+  }
 
  private:
   // --- medium: per model level, wavelength innermost (float)
@@ -144,6 +154,10 @@ class OrdersMethod : public SkyMethod {
     return ((ri * ns_ + si) * nu_ + k) * static_cast<size_t>(s_.nphi) + q;
   }
 
+  // Sky radiance (segment == nullptr) or a view segment's in-scattered radiance.
+  void Render(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,
+              const ViewSegment* segment, std::vector<double>* out) const;
+
   // Interpolates table `tab` (cells x nw) at a point, accumulating weight * value into acc.
   void Interpolate(const std::vector<float>& tab, double r, double theta_s, double mu, double cos_phi, double weight,
                    float* acc) const;
@@ -172,6 +186,9 @@ class OrdersMethod : public SkyMethod {
   size_t ns_ = 0, nu_ = 0;
   std::vector<double> sun_theta_rad_;
   std::vector<float> ms_;  // accumulated orders >= 2 at the observer radius: [(si*nu+k)*nphi+q]*nw
+  // Accumulated multiple-scattering source J_ms* = sum_{n>=2} J_n at every node (cells x nw),
+  // for view segments: L_seg,ms = int_0^t_end T* J_ms* dt.
+  std::vector<float> jms_;
   int orders_done_ = 0;
   bool tail_ = false;
   double last_fraction_ = 0.0;
@@ -650,6 +667,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
 
   // --- orders 2, 3, ...
   ms_.assign(ns_ * nu_ * nphi * nw_, 0.0f);
+  jms_.assign(cells * nw_, 0.0f);
   const size_t nd = nu_ * nphi;  // directions per (radius, sun)
   std::vector<float> E(ns_ * nw_);
   double prev_norm = 0.0, prev_ratio = -1.0;
@@ -705,6 +723,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
         }
       }
     });
+    for (size_t i = 0; i < jms_.size(); ++i) jms_[i] += J[i];
     ground_irradiance(L, &E);
     // L_n = int T* J_n dt + ground reflection of E_{n-1}.
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nr * ns_ * nu_, 4), [&](const tbb::blocked_range<size_t>& rg) {
@@ -761,6 +780,8 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
           for (size_t w = 0; w < nw_; ++w) a[w] += tail * v[w];
         }
       }
+      // The sources' tail: J_{k>n} ~ J_n rho / (1 - rho) as well.
+      for (size_t i = 0; i < jms_.size(); ++i) jms_[i] += tail * J[i];
       tail_ = true;
     }
     prev_ratio = ratio;
@@ -770,8 +791,8 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
 
 // ---------------------------------------------------------------------------- output
 
-void OrdersMethod::Radiance(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,
-                            std::vector<double>* out) const {
+void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,
+                          const ViewSegment* segment, std::vector<double>* out) const {
   const double R = m_.bottom_radius_m, top = m_.top_radius_m;
   const double r = R + observer_altitude_m;
   const double ts = sun_zenith_rad;
@@ -779,8 +800,8 @@ void OrdersMethod::Radiance(double observer_altitude_m, double sun_zenith_rad, c
   const size_t nd = nu_ * static_cast<size_t>(s_.nphi);
   // Log-linear interpolation of the MS table in the sun angle (exact for exponential twilight decay).
   const Lerp ls = Locate(sun_theta_rad_, ts);
-  std::vector<float> tsun(nw_), ssc(nw_), st(nw_), acc(nw_), ms0(nw_), ms1(nw_), pc(nc_ * nw_);
-  std::vector<double> tau(nw_);
+  std::vector<float> tsun(nw_), ssc(nw_), st(nw_), acc(nw_), ms0(nw_), ms1(nw_), pc(nc_ * nw_), jv(nw_);
+  std::vector<double> tau(nw_), tau_star(nw_), seg_ms(nw_);
   for (size_t d = 0; d < dirs.size(); ++d) {
     const double mu = std::clamp(dirs[d][2], -1.0, 1.0);
     const double sn = std::sqrt(std::max(0.0, 1.0 - mu * mu));
@@ -791,14 +812,22 @@ void OrdersMethod::Radiance(double observer_altitude_m, double sun_zenith_rad, c
       for (size_t w = 0; w < nw_; ++w) pc[c * nw_ + w] = static_cast<float>(phase_[c]->Eval(w, nu));
     }
     const double disc_g = r * r * (mu * mu - 1.0) + R * R;
-    const bool ground = mu < 0.0 && disc_g >= 0.0;
-    const double length = ground ? -r * mu - std::sqrt(std::max(0.0, disc_g))
-                                 : -r * mu + std::sqrt(std::max(0.0, r * r * (mu * mu - 1.0) + top * top));
+    // Segments never include the ground surface (transport/view_segment.h).
+    const bool ground = segment == nullptr && mu < 0.0 && disc_g >= 0.0;
+    double length;
+    if (segment != nullptr) {
+      length = SegmentEnd(m_, observer_altitude_m, mu, *segment);
+    } else {
+      length = mu < 0.0 && disc_g >= 0.0 ? -r * mu - std::sqrt(std::max(0.0, disc_g))
+                                         : -r * mu + std::sqrt(std::max(0.0, r * r * (mu * mu - 1.0) + top * top));
+    }
     std::fill(acc.begin(), acc.end(), 0.0f);
     std::fill(tau.begin(), tau.end(), 0.0);
+    std::fill(tau_star.begin(), tau_star.end(), 0.0);
+    std::fill(seg_ms.begin(), seg_ms.end(), 0.0);
     if (length > 0.0) {
-      // Steps uniform in t^(1/2)... spaced by the parameter s = (tau_ref/tau_tot + t/length)/2
-      // computed on a fine uniform sub-grid at the middle wavelength (as the table rays).
+      // Steps uniform in the parameter s = (tau_ref/tau_tot + t/length)/2 computed on a fine
+      // uniform sub-grid at the middle wavelength (as the table rays).
       const int nf = s_.fine;
       std::vector<double> cum(static_cast<size_t>(nf) + 1, 0.0);
       const size_t wref = nw_ / 2;
@@ -829,6 +858,10 @@ void OrdersMethod::Radiance(double observer_altitude_m, double sun_zenith_rad, c
           const double rmid = std::sqrt(r * r + 2.0 * r * mu * tmid + tmid * tmid);
           SigmaT(rmid - R, false, st.data());
           for (size_t w = 0; w < nw_; ++w) tau[w] += st[w] * (t - t_prev);
+          if (segment != nullptr) {
+            SigmaT(rmid - R, true, st.data());
+            for (size_t w = 0; w < nw_; ++w) tau_star[w] += st[w] * (t - t_prev);
+          }
           t_prev = t;
           const double mus = (r * std::cos(ts) + t * nu) / rr;
           SunTransmittance(rr, mus, false, tsun.data());
@@ -837,9 +870,20 @@ void OrdersMethod::Radiance(double observer_altitude_m, double sun_zenith_rad, c
             SigmaS(c, rr - R, false, st.data());
             for (size_t w = 0; w < nw_; ++w) ssc[w] += st[w] * pc[c * nw_ + w];
           }
-          const float hw = static_cast<float>(0.5 * h);
+          const float hw = static_cast<float>(segment == nullptr || segment->single_scattering ? 0.5 * h : 0.0);
           for (size_t w = 0; w < nw_; ++w) {
             acc[w] += hw * static_cast<float>(std::exp(-tau[w])) * ssc[w] * tsun[w] * static_cast<float>(sun_e_[w]);
+          }
+          if (segment != nullptr) {
+            // Multiple scattering of the segment: the tabulated source J_ms* at this point, in
+            // its local frame, attenuated by the scaled medium (the TMS split's L* part).
+            const double mus_c = std::clamp(mus, -1.0, 1.0);
+            const double mu2 = std::clamp((r * mu + t) / rr, -1.0, 1.0);
+            const double denom = std::sqrt(std::max(1e-12, (1.0 - mu2 * mu2) * (1.0 - mus_c * mus_c)));
+            const double cphi2 = std::clamp((nu - mu2 * mus_c) / denom, -1.0, 1.0);
+            std::fill(jv.begin(), jv.end(), 0.0f);
+            Interpolate(jms_, rr, std::acos(mus_c), mu2, cphi2, 1.0, jv.data());
+            for (size_t w = 0; w < nw_; ++w) seg_ms[w] += 0.5 * h * std::exp(-tau_star[w]) * jv[w];
           }
         }
       }
@@ -859,6 +903,10 @@ void OrdersMethod::Radiance(double observer_altitude_m, double sun_zenith_rad, c
           acc[w] += static_cast<float>(std::exp(-tau[w]) * albedo_[w] / kPi * sun_e_[w] * std::max(0.0, mus_g)) * tsun[w];
         }
       }
+    }
+    if (segment != nullptr) {
+      for (size_t w = 0; w < nw_; ++w) (*out)[d * nw_ + w] = acc[w] + std::max(0.0, seg_ms[w]);
+      continue;
     }
     // --- multiple scattering from the table at the observer radius
     std::fill(ms0.begin(), ms0.end(), 0.0f);

@@ -214,10 +214,10 @@ void PathTracer::SunNee(const glm::dvec3& x, const glm::dvec3& d, bool ground, c
 
 
 void PathTracer::SegmentSunNee(const glm::dvec3& p, const glm::dvec3& d, const double* beta, const size_t* idx, int k,
-                               const glm::dvec3& sun, Pcg32& rng, double* L) const {
+                               const glm::dvec3& sun, Pcg32& rng, double* L, double t_cap) const {
   const double R = model_.bottom_radius_m, top = model_.top_radius_m;
   const SphereHit g = NearSphere(p, d, R);
-  const double t_end = g.hit ? g.t : FarSphere(p, d, top);
+  const double t_end = std::min(t_cap, g.hit ? g.t : FarSphere(p, d, top));
   if (!(t_end > 0.0)) return;
   // Lit set along x(t) = p + t d: the planet hides the whole disk from x iff x.s < 0 and the
   // distance of x from the shadow axis is below the planet radius, shrunk by the penumbra
@@ -343,7 +343,11 @@ void PathTracer::SegmentSunNee(const glm::dvec3& p, const glm::dvec3& d, const d
 }
 
 void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, const size_t* idx, int k, Pcg32& rng,
-                           double* L) const {
+                           double* L, double view_t_end, bool single_scattering) const {
+  // Segment mode (view_t_end finite): the first flight ends at view_t_end, the path dies there
+  // and at the ground (no surface term); later flights are unrestricted.
+  const bool segment = std::isfinite(view_t_end);
+  double travelled = 0.0;
   double beta[kMaxWavelengths];
   for (int j = 0; j < k; ++j) {
     beta[j] = 1.0;
@@ -356,7 +360,12 @@ void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, co
   // `depth` = scattering and reflection events so far; a sun connection made now is of order
   // depth + 1.
   for (int depth = 0; depth < 100000; ++depth) {
-    if (segment_nee && depth + 1 <= max_order) SegmentSunNee(p, d, beta, idx, k, sun, rng, L);
+    // Order-1 sun connections are skipped when single scattering is excluded (shadowed fog).
+    const bool nee_here = depth + 1 <= max_order && (single_scattering || depth > 0);
+    if (segment_nee && nee_here) {
+      SegmentSunNee(p, d, beta, idx, k, sun, rng, L,
+                    segment && depth == 0 ? view_t_end : std::numeric_limits<double>::infinity());
+    }
     // ---- free flight to the next real scattering event, the ground, or space
     enum class Event { kScatter, kGround, kEscape } event = Event::kEscape;
     for (int guard = 0;; ++guard) {
@@ -366,11 +375,15 @@ void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, co
       const bool down = inner.hit;
       const double t_exit = down ? inner.t : FarSphere(p, d, sh.radius_hi);
       const double mu_bar = Majorant(s, idx, k);
+      // What is left of the view segment from this shell's entry point.
+      const double t_limit =
+          segment && depth == 0 ? view_t_end - travelled : std::numeric_limits<double>::infinity();
       double t = 0.0;
       bool scattered = false;
       if (mu_bar > 0.0) {
         for (;;) {
           t -= std::log(1.0 - rng.Uniform()) / mu_bar;
+          if (t >= t_limit && t_limit <= t_exit) return;  // beyond the view segment
           if (t >= t_exit) break;
           const glm::dvec3 x = p + t * d;
           const AtmosphereModel::Cell cell = model_.Locate(glm::length(x) - model_.bottom_radius_m);
@@ -398,6 +411,10 @@ void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, co
         break;
       }
       p += t_exit * d;
+      if (segment && depth == 0) {
+        travelled += t_exit;
+        if (t_exit >= t_limit) return;  // the segment ends inside this shell
+      }
       if (down) {
         if (s == 0) {
           event = Event::kGround;
@@ -423,8 +440,9 @@ void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, co
     }
 
     if (event == Event::kGround) {
+      if (segment && depth == 0) return;  // fog: the surface is not part of a view segment
       const glm::dvec3 n = glm::normalize(p);
-      if (sun_mode && depth + 1 <= max_order) SunNee(p, d, true, beta, idx, k, sun, rng, L);
+      if (sun_mode && nee_here) SunNee(p, d, true, beta, idx, k, sun, rng, L);
       if (depth + 1 >= max_order && sun_mode) return;
       // Cosine-weighted bounce: f cos / pdf = albedo.
       double bmax = 0.0;
@@ -438,7 +456,7 @@ void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, co
       s = 0;
     } else {
       // Medium scattering vertex.
-      if (sun_mode && !segment_nee && depth + 1 <= max_order) SunNee(p, d, false, beta, idx, k, sun, rng, L);
+      if (sun_mode && !segment_nee && nee_here) SunNee(p, d, false, beta, idx, k, sun, rng, L);
       if (depth + 1 >= max_order && sun_mode) return;
       const AtmosphereModel::Cell cell = model_.Locate(glm::length(p) - model_.bottom_radius_m);
       // Component choice ~ sum_j |b_j| mu_s,c(lambda_j); direction from that component's phase
@@ -487,7 +505,8 @@ void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, co
 }
 
 ColorEstimate PathTracer::Estimate(const glm::dvec3& position, const glm::dvec3& direction,
-                                   const glm::dvec3& sun_direction, uint64_t stream, bool cosine_hemisphere) const {
+                                   const glm::dvec3& sun_direction, uint64_t stream, bool cosine_hemisphere,
+                                   double view_t_end, bool single_scattering) const {
   const size_t n_wl = model_.wavelengths();
   const int k = static_cast<int>(std::min<size_t>(static_cast<size_t>(settings_.wavelengths_per_path), n_wl));
   const double scale = static_cast<double>(n_wl) / k;
@@ -512,7 +531,7 @@ ColorEstimate PathTracer::Estimate(const glm::dvec3& position, const glm::dvec3&
         weight = kPi;  // E = pi E_cos[L]
       }
       double L[kMaxWavelengths];
-      TracePath(start, d, sun_direction, idx, k, rng, L);
+      TracePath(start, d, sun_direction, idx, k, rng, L, view_t_end, single_scattering);
       double xyz[3] = {0, 0, 0};
       for (int j = 0; j < k; ++j) {
         for (int c = 0; c < 3; ++c) xyz[c] += scale * weight * xyz_weights_[idx[j]][static_cast<size_t>(c)] * L[j];
@@ -546,11 +565,19 @@ ColorEstimate PathTracer::Estimate(const glm::dvec3& position, const glm::dvec3&
 
 ColorEstimate PathTracer::Radiance(const glm::dvec3& position, const glm::dvec3& direction,
                                    const glm::dvec3& sun_direction, uint64_t stream) const {
-  return Estimate(position, direction, sun_direction, stream, false);
+  return Estimate(position, direction, sun_direction, stream, false, std::numeric_limits<double>::infinity(), true);
+}
+
+ColorEstimate PathTracer::SegmentRadiance(const glm::dvec3& position, const glm::dvec3& direction,
+                                          const glm::dvec3& sun_direction, double t_end, uint64_t stream,
+                                          bool single_scattering) const {
+  SKYBAKE_CHECK(t_end >= 0.0 && std::isfinite(t_end));
+  return Estimate(position, direction, sun_direction, stream, false, t_end, single_scattering);
 }
 
 ColorEstimate PathTracer::Irradiance(const glm::dvec3& position, const glm::dvec3& sun_direction, uint64_t stream) const {
-  return Estimate(position, glm::normalize(position), sun_direction, stream, true);
+  return Estimate(position, glm::normalize(position), sun_direction, stream, true,
+                  std::numeric_limits<double>::infinity(), true);
 }
 
 void PathTracer::SpectralRadiance(const glm::dvec3& position, const glm::dvec3& direction,

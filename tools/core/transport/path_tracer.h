@@ -37,6 +37,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -94,6 +95,12 @@ class PathTracer {
   // the sun centre along `sun_direction` (unit). Adaptive to the target error.
   ColorEstimate Radiance(const glm::dvec3& position, const glm::dvec3& direction, const glm::dvec3& sun_direction,
                          uint64_t stream) const;
+  // In-scattered radiance from the view segment [0, t_end] only (transport/view_segment.h:
+  // t_end from SegmentEnd; the ground surface is excluded). single_scattering = false leaves
+  // out the order-1 sun connections (shadowed fog). Adaptive.
+  ColorEstimate SegmentRadiance(const glm::dvec3& position, const glm::dvec3& direction,
+                                const glm::dvec3& sun_direction, double t_end, uint64_t stream,
+                                bool single_scattering = true) const;
   // Irradiance from the sky on a horizontal surface at `position` (hemispherical integral of
   // radiance x cos, XYZ: lux), by cosine-weighted view directions. Adaptive.
   ColorEstimate Irradiance(const glm::dvec3& position, const glm::dvec3& sun_direction, uint64_t stream) const;
@@ -104,8 +111,11 @@ class PathTracer {
                         std::vector<double>* mean, std::vector<double>* stderr_out) const;
 
   // One path: L[j] for the k wavelengths idx[j] (k <= kMaxWavelengths).
+  // A finite `view_t_end` restricts the first flight to [0, view_t_end] with no ground surface
+  // (segment mode, as SegmentRadiance).
   void TracePath(glm::dvec3 position, glm::dvec3 direction, const glm::dvec3& sun_direction, const size_t* idx, int k,
-                 Pcg32& rng, double* L) const;
+                 Pcg32& rng, double* L, double view_t_end = std::numeric_limits<double>::infinity(),
+                 bool single_scattering = true) const;
   // Ratio-tracking transmittance from `position` along `direction` to the top of the
   // atmosphere (0 if the ray hits the ground) for k wavelengths.
   void Transmittance(const glm::dvec3& position, const glm::dvec3& direction, const size_t* idx, int k, Pcg32& rng,
@@ -125,7 +135,7 @@ class PathTracer {
 
  private:
   ColorEstimate Estimate(const glm::dvec3& position, const glm::dvec3& direction, const glm::dvec3& sun_direction,
-                         uint64_t stream, bool cosine_hemisphere) const;
+                         uint64_t stream, bool cosine_hemisphere, double view_t_end, bool single_scattering) const;
   size_t ShellOf(double radius) const;
   double Majorant(size_t shell, const size_t* idx, int k) const;
   // Sun next-event estimate at a medium or ground vertex: adds to L.
@@ -133,8 +143,9 @@ class PathTracer {
               const glm::dvec3& sun, Pcg32& rng, double* L) const;
   double MixturePhase(const AtmosphereModel::Cell& cell, size_t wl, double mu) const;
   // Segment NEE (see PathTracerSettings::segment_nee) for the segment from p along d.
+  // Only the part of the segment before t_cap is used.
   void SegmentSunNee(const glm::dvec3& p, const glm::dvec3& d, const double* beta, const size_t* idx, int k,
-                     const glm::dvec3& sun, Pcg32& rng, double* L) const;
+                     const glm::dvec3& sun, Pcg32& rng, double* L, double t_cap) const;
 
   const AtmosphereModel& model_;
   std::vector<std::array<double, 3>> xyz_weights_;

@@ -12,6 +12,11 @@
 
 namespace skybake {
 
+void SkyMethod::SegmentRadiance(double, double, const std::vector<std::array<double, 3>>&, const ViewSegment&,
+                                std::vector<double>*) const {
+  throw UsageError("--method " + Name() + " does not render view segments (fog); use orders or path");
+}
+
 std::vector<std::string> SkyMethodNames() { return {"single", "orders", "ms-approx", "analytic"}; }
 
 std::unique_ptr<SkyMethod> MakeSkyMethod(const std::string& name, const AtmosphereModel& model,

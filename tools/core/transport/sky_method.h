@@ -16,6 +16,7 @@
 
 #include "atmosphere/model.h"
 #include "io/progress.h"
+#include "transport/view_segment.h"
 
 namespace skybake {
 
@@ -44,6 +45,13 @@ class SkyMethod {
   // is excluded, as in the path tracer. Const and thread-safe.
   virtual void Radiance(double observer_altitude_m, double sun_zenith_rad,
                         const std::vector<std::array<double, 3>>& dirs, std::vector<double>* out) const = 0;
+  // In-scattered spectral radiance from a view segment only (transport/view_segment.h: the
+  // medium at t <= t_end, no ground surface), same layout as Radiance. Methods that cannot
+  // cut the view ray throw UsageError (the default).
+  virtual bool SupportsSegments() const { return false; }
+  virtual void SegmentRadiance(double observer_altitude_m, double sun_zenith_rad,
+                               const std::vector<std::array<double, 3>>& dirs, const ViewSegment& segment,
+                               std::vector<double>* out) const;
 };
 
 // Builds a method by name ("single", "orders", "ms-approx", "analytic"); UsageError for an
