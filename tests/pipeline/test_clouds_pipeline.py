@@ -31,7 +31,8 @@ channels:
 """
 
 # A minimal atmosphere (no aerosols, so no mie-tables edges): the clouds do not depend on it, but
-# pipeline.yaml requires one.
+# pipeline.yaml requires one. It has no ground or sun, so the pipeline renders no sky of it
+# (`sky: {atmospheres: []}`).
 ATMOSPHERE = """name: plain
 planet: {radius_km: 6371, top_km: 100}
 air: {profile: ussa1976}
@@ -45,6 +46,7 @@ clouds:
   cumulus: clouds/cumulus.yaml
   cumulus_times_s: %s
   coverage: clouds/coverage.yaml
+sky: {atmospheres: []}
 """
 
 

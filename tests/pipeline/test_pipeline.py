@@ -206,6 +206,19 @@ class PipelineTest(TempDirTestCase):
         r = self.ninja()
         self.assertEqual(edges_run(r.stdout), ["Regenerating build.ninja"])
 
+    def test_atmosphere_without_ground_or_sun_is_reported_at_generate_time(self):
+        # A sky render needs the whole atmosphere; the generator names the atmosphere file rather
+        # than letting sky-render fail later on the generated component.
+        p = self.path("atmospheres", "clear.yaml")
+        with open(p) as f:
+            text = f.read()
+        with open(p, "w") as f:
+            f.write(re.sub(r"^ground:\n(?:[ #].*\n)*", "", text, flags=re.M))
+        r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
+        self.assertIn("skybake: %s: missing section 'ground'" % p, r.stderr)
+        self.assertFalse(os.path.exists(os.path.join(self.out, "build.ninja")))
+
     def test_graph_prints_the_plan_without_writing(self):
         r = run([tool("skybake"), "graph", "pipeline.yaml"], cwd=self.tmp)
         self.assertEqual(r.returncode, 0, r.stderr)

@@ -78,6 +78,9 @@ class SkyRenderStage : public Stage {
       const std::filesystem::path comp_rel = paths::RenderComponent(a.name);
       ctx.WriteComponent(comp_rel, CanonicalRenderYaml(a.spec, (ctx.pipeline().out_dir / comp_rel).parent_path()));
       if (only_ && !only_->count(a.name)) continue;  // the component is still written: other renderers use it
+      // A render needs the whole atmosphere: say so now, naming the atmosphere file, rather than
+      // when ninja runs sky-render on the generated component.
+      RequireSections(a.spec, {"planet", "air", "ground", "sun"});
       NinjaBuild b;
       b.outputs = {paths::Sky(a.name).generic_string()};
       if (preview_) b.implicit_outputs = {paths::SkyPreview(a.name).generic_string()};
