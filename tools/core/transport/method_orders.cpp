@@ -30,6 +30,8 @@ struct OrdersSettings {
   int nss = 96;              // steps along an output view ray (single scattering)
   int fine = 256;            // pieces for optical depths along a ray
   double truncation_deg = 15.0;
+  bool normalise = true;     // kernel rows scaled to conserve energy
+  bool early_tail = true;    // stop with the geometric tail once it is accurate to `tolerance`
   int max_orders = 40;
   double tolerance = 1e-3;
   std::vector<double> sun_deg;  // sun zenith nodes
@@ -59,6 +61,12 @@ OrdersSettings SettingsFor(const SkyMethodOptions& o) {
   int trunc = 0;
   get("truncation_deg", &trunc);
   if (trunc > 0) s.truncation_deg = trunc;
+  int norm = -1;
+  get("normalise", &norm);
+  if (norm >= 0) s.normalise = norm != 0;
+  int early = -1;
+  get("early_tail", &early);
+  if (early >= 0) s.early_tail = early != 0;
   if (o.view_steps > 0) s.nss = o.view_steps;
   if (o.orders > 0) s.max_orders = o.orders;
   if (o.order_tolerance > 0) s.tolerance = o.order_tolerance;
@@ -671,6 +679,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
   const size_t nd = nu_ * nphi;  // directions per (radius, sun)
   std::vector<float> E(ns_ * nw_);
   double prev_norm = 0.0, prev_ratio = -1.0;
+  bool last_order_tail = false;
   const size_t wref = nw_ / 2;
   for (int order = 2; order <= s_.max_orders; ++order) {
     ReportProgress(progress, fmt::format("orders: order {}", order), 0.0);
@@ -681,8 +690,10 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
         const double r = radius_[ri];
         // The mixture phase x scattering coefficient on the cos grid at this radius.
         std::fill(mix.begin(), mix.end(), 0.0f);
+        std::vector<double> ssc_total(nw_, 0.0);
         for (size_t c = 0; c < nc_; ++c) {
           SigmaS(c, r - R, true, ssc.data());
+          for (size_t w = 0; w < nw_; ++w) ssc_total[w] += ssc[w];
           for (int g = 0; g < kPhaseGrid; ++g) {
             for (size_t w = 0; w < nw_; ++w) mix[static_cast<size_t>(g) * nw_ + w] += ssc[w] * phase_star_[(c * kPhaseGrid + static_cast<size_t>(g)) * nw_ + w];
           }
@@ -708,6 +719,22 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
             float* out = &kernel[(i * nd + j) * nw_];
             mix_at(mu * mu2 + sn * sn2 * std::cos(phi - phi2), wgt, out);
             mix_at(mu * mu2 + sn * sn2 * std::cos(phi + phi2), wgt, out);
+          }
+          if (s_.normalise) {
+            // Energy conservation of the discrete phase integral: every row must sum to
+            // sigma_s* (the phase function integrates to 1 over incoming directions); point
+            // sampling of a peaked phase on ~200 directions misses that by a few per cent.
+            std::vector<double> row(nw_, 0.0);
+            for (size_t j = 0; j < nd; ++j) {
+              const float* kv = &kernel[(i * nd + j) * nw_];
+              for (size_t w = 0; w < nw_; ++w) row[w] += kv[w];
+            }
+            std::vector<float> scale(nw_, 1.0f);
+            for (size_t w = 0; w < nw_; ++w) scale[w] = row[w] > 0.0 ? static_cast<float>(ssc_total[w] / row[w]) : 1.0f;
+            for (size_t j = 0; j < nd; ++j) {
+              float* kv = &kernel[(i * nd + j) * nw_];
+              for (size_t w = 0; w < nw_; ++w) kv[w] *= scale[w];
+            }
           }
         }
         for (size_t si = 0; si < ns_; ++si) {
@@ -770,7 +797,15 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
     last_fraction_ = total > 0.0 ? norm / total : 0.0;
     const double ratio = prev_norm > 0.0 ? norm / prev_norm : -1.0;
     if (last_fraction_ < s_.tolerance) break;
-    if (order == s_.max_orders && ratio > 0.0 && ratio < 1.0 && prev_ratio > 0.0 && std::abs(ratio - prev_ratio) < 0.02) {
+    // Geometric tail once the ratio of successive orders has settled: the remaining orders sum
+    // to L_n rho / (1 - rho), and an error d_rho in rho changes that by about
+    // fraction_n d_rho / (1 - rho)^2 of the total; stop when that is below the tolerance (or at
+    // the last allowed order if the ratio has settled at all).
+    const bool settled = ratio > 0.0 && ratio < 1.0 && prev_ratio > 0.0;
+    const double tail_error =
+        settled ? last_fraction_ * std::abs(ratio - prev_ratio) / ((1.0 - ratio) * (1.0 - ratio)) : 1.0;
+    if (settled && s_.early_tail && order >= 4 && tail_error < s_.tolerance) last_order_tail = true;
+    if (last_order_tail || (order == s_.max_orders && settled && std::abs(ratio - prev_ratio) < 0.02)) {
       // Geometric tail: sum_{k>n} L_k ~ L_n rho / (1 - rho).
       const float tail = static_cast<float>(ratio / (1.0 - ratio));
       for (size_t si = 0; si < ns_; ++si) {
@@ -783,6 +818,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
       // The sources' tail: J_{k>n} ~ J_n rho / (1 - rho) as well.
       for (size_t i = 0; i < jms_.size(); ++i) jms_[i] += tail * J[i];
       tail_ = true;
+      break;
     }
     prev_ratio = ratio;
     prev_norm = norm;
