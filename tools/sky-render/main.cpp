@@ -6,6 +6,7 @@
 //              [--sun-zenith-deg 30,70,85,90,94 | --time-mapping gt7] [--target-error 0.01] [--preview sky.png] ...
 //   sky-render points ATMOSPHERE.yaml --geometry in.csv -o out.csv [--wavelengths-out 440,550,680]
 //   sky-render budget ATMOSPHERE.yaml -o budget.csv [--tolerance 1%] [--method ms-approx] ...
+//   sky-render fog ATMOSPHERE.yaml -o fog.exr [--method orders|path] [--cut-altitude-km 3.5] ... (docs/fog.md)
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -19,6 +20,7 @@
 #include "atmosphere/vertical_profiles.h"
 #include "color/color.h"
 #include "color/exr_color.h"
+#include "fog/fog_render.h"
 #include "io/cli.h"
 #include "io/csv.h"
 #include "io/exr.h"
@@ -113,7 +115,50 @@ int main(int argc, char** argv) {
   budget->add_option("--altitude-range-m", altitude_range,
                      "Observer altitude range lo:hi (m) for the altitude dimension (default: the observer's + 0..300 m)");
 
+  CLI::App* fog = cli.app().add_subcommand(
+      "fog", "Reference fog of the low atmosphere: GT7 fog LUT slices, depth tables, attenuation (docs/fog.md)");
+  add_scene_options(fog);
+  fog::FogRenderOptions fo;
+  double cut_km = 3.5;
+  std::string lut_size = "32x32", att_size = "64x64";
+  fog->add_option("--method", fo.method, "orders (deterministic, all orders) or path (the Monte-Carlo reference)")
+      ->default_val("orders");
+  fog->add_option("--quality", fo.method_options.quality, "orders: low, medium or high")->default_val("medium");
+  fog->add_option("--cut-altitude-km", cut_km, "Top of the low atmosphere that scatters into the fog (km; docs/fog.md)")
+      ->default_val(3.5);
+  fog->add_option("--observer-altitude-m", fo.observer_altitude_m, "Override the atmosphere's observer altitude (m)");
+  fog->add_option("--lut-size", lut_size, "Fog LUT slices on the GT7 sphere mapping, WxH")->default_val("32x32");
+  fog->add_option("--time-mapping", fo.time_mapping, "GT7 time mapping of the slices: gt7, gt7-quadratic[:<upper>+<lower>]")
+      ->default_val("gt7-quadratic");
+  fog->add_option("--sun-zenith-deg", fo.sun_zenith_deg, "Sun zenith angles of the depth tables (deg), comma separated")
+      ->delimiter(',')->default_str("30,60,80,88,92,96");
+  fog->add_option("--elevations", fo.elevations, "Depth tables: view elevations 90 (i/(m-1))^2 deg, i = 0..m-1")
+      ->default_val(17);
+  fog->add_option("--azimuths-deg", fo.azimuth_deg, "Depth tables: view azimuths from the sun (deg), comma separated")
+      ->delimiter(',')->default_str("0,10,30,60,90,120,150,180");
+  fog->add_option("--depths", fo.depths, "Depth tables: normalised depths (j/n)^3, j = 1..n")->default_val(32);
+  fog->add_option("--attenuation-size", att_size, "Attenuation LUT nodes, WxH (u = depth^(1/3), v = elevation^(1/2))")
+      ->default_val("64x64");
+
   return cli.Run(argc, argv, [&] {
+    if (fog->parsed()) {
+      auto size = [](const std::string& text, const char* opt, int* w, int* h) {
+        char tail = 0;
+        if (std::sscanf(text.c_str(), "%dx%d%c", w, h, &tail) != 2) {
+          throw UsageError(std::string(opt) + ": expected WxH, got '" + text + "'");
+        }
+      };
+      size(lut_size, "--lut-size", &fo.lut_width, &fo.lut_height);
+      size(att_size, "--attenuation-size", &fo.attenuation_width, &fo.attenuation_height);
+      if (!(cut_km > 0.0 && cut_km < 1e4)) throw UsageError("--cut-altitude-km: expected a positive altitude in km");
+      fo.cut_altitude_m = cut_km * 1e3;
+      Scene s = LoadScene(scene, cli.Progress());
+      const fog::FogRender r = fog::RenderFog(s, fo, cli.Progress());
+      fog::WriteFogRender(s, fo, r, output, cli.name());
+      cli.Info(fmt::format("{} fog LUT slices, {} depth tables", r.slice_zenith_deg.size(), r.tables.size()));
+      if (!depfile.empty()) WriteDepfile(depfile, output, s.files_read);
+      return;
+    }
     if (ro.sun_zenith_deg.empty()) ro.sun_zenith_deg = {30, 70, 85, 90, 94};
     if (po.wavelengths_nm.empty()) po.wavelengths_nm = {440, 550, 680};
     if (budget->parsed()) {

@@ -1,0 +1,686 @@
+#include "fog/fog_luts.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include <fmt/format.h>
+
+#include "color/exr_color.h"
+#include "io/error.h"
+#include "io/png.h"
+#include "io/yaml.h"
+#include "lut/dds.h"
+#include "lut/ktx2.h"
+#include "skybake/version.h"
+#include "spectrum/cmf.h"
+#include "spectrum/grid.h"
+#include "spectrum/xyz.h"
+
+namespace fs = std::filesystem;
+
+namespace skybake::fog {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kDeg = kPi / 180.0;
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+std::array<double, 3> DirOf(double elevation_deg, double azimuth_deg) {
+  const double e = elevation_deg * kDeg, a = azimuth_deg * kDeg;
+  return {std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e)};
+}
+
+// Accumulates ErrorStats serially.
+struct Accumulator {
+  ErrorStats s;
+  double sum2 = 0.0;
+  std::array<double, 3> c2{0, 0, 0};
+  std::array<size_t, 3> cn{0, 0, 0};
+  void Add(double e, const std::array<double, 3>& ec, double sza, double elev, double az, double depth_m, double x) {
+    ++s.count;
+    sum2 += e * e;
+    if (std::fabs(e) > s.max) {
+      s.max = std::fabs(e);
+      s.max_sun_zenith_deg = sza;
+      s.max_elevation_deg = elev;
+      s.max_azimuth_deg = az;
+      s.max_depth_m = depth_m;
+      s.max_x = x;
+    }
+    for (int c = 0; c < 3; ++c) {
+      if (std::isfinite(ec[c])) {
+        c2[c] += ec[c] * ec[c];
+        ++cn[c];
+      }
+    }
+  }
+  ErrorStats Done() const {
+    ErrorStats o = s;
+    o.rms = s.count ? std::sqrt(sum2 / static_cast<double>(s.count)) : 0.0;
+    for (int c = 0; c < 3; ++c) o.channel_rms[c] = cn[c] ? std::sqrt(c2[c] / static_cast<double>(cn[c])) : 0.0;
+    return o;
+  }
+};
+
+struct ProductAccumulator {
+  Accumulator all, near, horizon, near_horizon, far, infinite_depth;
+  std::vector<Accumulator> near_per_sun, all_per_sun;
+  ProductStats Done() const {
+    ProductStats p{all.Done(), near.Done(), horizon.Done(), near_horizon.Done(), far.Done(), infinite_depth.Done(), {}, {}};
+    for (const Accumulator& a : near_per_sun) p.near_per_sun.push_back(a.Done());
+    for (const Accumulator& a : all_per_sun) p.all_per_sun.push_back(a.Done());
+    return p;
+  }
+};
+
+// Linear Rec.2020 -> Y (the OCIO transform is linear between these linear spaces).
+std::array<double, 3> LuminanceRow(const ColorProcessor& to_xyz) {
+  std::array<double, 3> row{};
+  for (int c = 0; c < 3; ++c) {
+    std::array<float, 3> e{0, 0, 0};
+    e[c] = 1.0f;
+    row[c] = to_xyz.Apply(e)[1];
+  }
+  return row;
+}
+
+double Dot(const std::array<double, 3>& a, const std::array<double, 3>& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+}  // namespace
+
+FogEvaluator MakeEvaluator(const FogProducts& p) {
+  const lut::SkyRender& r = p.layout;
+  lut::SkyLutDecoder fog(r.width, r.height, r.time, r.sphere, p.fog.decoded_rgb, {0, 0, 0}, p.options.night_end_zenith_deg);
+  lut::SkyLutDecoder sh(r.width, r.height, r.time, r.sphere, p.shadowed.decoded_rgb, {0, 0, 0}, p.options.night_end_zenith_deg);
+  AttenuationLut att(p.attenuation.width, p.attenuation.height, p.attenuation.decoded_rgb);
+  return FogEvaluator(p.params, std::move(fog), std::move(sh), std::move(att));
+}
+
+FogProducts BuildFogProducts(const FogRender& render, const std::string& sky, const FogFitOptions& o,
+                             const ColorConfig& config, std::vector<fs::path>* files_read) {
+  FogProducts out;
+  out.sky = sky;
+  out.options = o;
+  const FogGeometry geo = render.geometry();
+  const ColorProcessor to2020 = config.Converter(ocio_names::kCieXyzD65, ocio_names::kLinearRec2020);
+  const ColorProcessor to_xyz = config.Converter(ocio_names::kLinearRec2020, ocio_names::kCieXyzD65);
+  const std::array<double, 3> y_row = LuminanceRow(to_xyz);
+
+  const size_t ne = render.elevation_deg.size(), na = render.azimuth_deg.size(), nx = render.depth_x.size();
+  const size_t n_tab = render.tables.size();
+  // Reference fog in Linear Rec.2020, per table.
+  std::vector<std::vector<float>> ref(n_tab), ref_sh(n_tab);
+  for (size_t s = 0; s < n_tab; ++s) {
+    ref[s] = render.tables[s].xyz;
+    ref_sh[s] = render.tables[s].shadowed_xyz;
+    to2020.Apply(ref[s]);
+    to2020.Apply(ref_sh[s]);
+  }
+  std::vector<double> mu(ne), theta(ne), depth_max(ne);
+  for (size_t e = 0; e < ne; ++e) {
+    mu[e] = std::sin(render.elevation_deg[e] * kDeg);
+    theta[e] = geo.Theta(o.angle, mu[e]);
+    depth_max[e] = geo.BoundaryDistanceM(mu[e]);
+  }
+
+  // ---- Fits. Samples: every table, elevation, azimuth and depth x < 1 of the reference, the
+  // target the fog at x over the fog at x = 1 of the same direction and sun.
+  auto fit_product = [&](const std::vector<std::vector<float>>& data, std::array<FitResult, 3>* fits, std::array<double, 3>* a,
+                         std::array<double, 3>* p) {
+    const int channels = o.per_channel ? 3 : 1;
+    for (int c = 0; c < channels; ++c) {
+      std::vector<FitSample> samples;
+      samples.reserve(n_tab * ne * na * nx);
+      for (size_t s = 0; s < n_tab; ++s) {
+        for (size_t e = 0; e < ne; ++e) {
+          for (size_t az = 0; az < na; ++az) {
+            const size_t i1 = render.TableIndex(e, az, nx - 1);
+            const double v1 = o.per_channel ? data[s][i1 * 3 + c] : Dot(y_row, {data[s][i1 * 3], data[s][i1 * 3 + 1], data[s][i1 * 3 + 2]});
+            for (size_t j = 0; j + 1 < nx; ++j) {
+              const size_t i = render.TableIndex(e, az, j);
+              const double v = o.per_channel ? data[s][i * 3 + c] : Dot(y_row, {data[s][i * 3], data[s][i * 3 + 1], data[s][i * 3 + 2]});
+              samples.push_back({theta[e], render.depth_x[j], v1 > 0.0 ? v / v1 : -1.0});
+            }
+          }
+        }
+      }
+      const FitResult f = FitDepthFactor(samples, o.fit);
+      for (int k = (o.per_channel ? c : 0); k < (o.per_channel ? c + 1 : 3); ++k) {
+        (*fits)[static_cast<size_t>(k)] = f;
+        (*a)[static_cast<size_t>(k)] = f.a;
+        (*p)[static_cast<size_t>(k)] = f.p;
+      }
+    }
+  };
+  FogParams& par = out.params;
+  par.basis_sky = sky;
+  par.angle = o.angle;
+  par.planet_radius_m = render.planet_radius_m;
+  par.observer_altitude_m = render.observer_altitude_m;
+  par.cut_altitude_m = render.cut_altitude_m;
+  fit_product(ref, &out.fit_fog, &par.a, &par.p);
+  fit_product(ref_sh, &out.fit_shadowed, &par.a_shadowed, &par.p_shadowed);
+
+  // ---- Pack the LUTs.
+  lut::SkyRender& lay = out.layout;
+  lay.path = render.path;
+  lay.width = render.lut_width;
+  lay.height = render.lut_height;
+  lay.time = render.time;
+  lay.time_mapping_name = render.time_mapping_name;
+  lay.sphere = render.sphere;
+  lay.slice_zenith_deg = render.slice_zenith_deg;
+  lay.observer = render.observer;
+  lay.method = render.method;
+  const int n_slices = static_cast<int>(render.slice_zenith_deg.size());
+  auto pack_slices = [&](const std::vector<std::vector<float>>& slices) {
+    std::vector<float> rgb;
+    for (const std::vector<float>& s : slices) rgb.insert(rgb.end(), s.begin(), s.end());
+    to2020.Apply(rgb);
+    return lut::PackRgb(render.lut_width, render.lut_height, n_slices, rgb, lut::AutomaticScale(rgb), to_xyz);
+  };
+  out.fog = pack_slices(render.slice_xyz);
+  out.shadowed = pack_slices(render.slice_shadowed_xyz);
+
+  // Attenuation: sunlight-weighted channel transmittance, [E0 T]_c / [E0]_c (as lut-pack's
+  // transmittance LUT; lut/sky_lut.cpp BuildLutSet), Linear Rec.2020.
+  const std::optional<Observer> obs = ParseObserver(render.observer);
+  if (!obs) throw InputError(FileLoc{render.path, 0}, "unknown observer '" + render.observer + "'");
+  const Cmf cmf = Cmf::LoadDefault(*obs);
+  if (files_read) files_read->push_back(cmf.path());
+  const XyzWeights w(WavelengthGrid::List(render.wavelength_nm, FileLoc{render.path, 0}), cmf);
+  const ColorProcessor obs_to2020 = config.Converter(XyzColorSpace(*obs), ocio_names::kLinearRec2020);
+  const size_t nw = render.wavelength_nm.size();
+  auto sun_rgb = [&](const float* T) {
+    std::vector<double> spec(nw);
+    for (size_t l = 0; l < nw; ++l) spec[l] = render.sun_e0[l] * (T ? T[l] : 1.0);
+    const Xyz x = w.Integrate(std::span<const double>(spec));
+    return obs_to2020.Apply(std::array<float, 3>{static_cast<float>(x.X), static_cast<float>(x.Y), static_cast<float>(x.Z)});
+  };
+  const std::array<float, 3> e0_rgb = sun_rgb(nullptr);
+  for (int c = 0; c < 3; ++c) {
+    if (!(e0_rgb[c] > 0.0f)) throw InputError(FileLoc{render.path, 0}, "the sun's colour has a non-positive Rec.2020 channel");
+  }
+  auto t_rgb = [&](const float* T) {
+    const std::array<float, 3> c = sun_rgb(T);
+    return std::array<float, 3>{c[0] / e0_rgb[0], c[1] / e0_rgb[1], c[2] / e0_rgb[2]};
+  };
+  {
+    std::vector<float> rgb;
+    const size_t nodes = static_cast<size_t>(render.attenuation_width) * render.attenuation_height;
+    for (size_t q = 0; q < nodes; ++q) {
+      const std::array<float, 3> c = t_rgb(&render.attenuation[q * nw]);
+      rgb.insert(rgb.end(), c.begin(), c.end());
+    }
+    out.attenuation = lut::PackRgb(render.attenuation_width, render.attenuation_height, 1, rgb, lut::AutomaticScale(rgb), to_xyz);
+  }
+
+  // ---- Errors. Fit: ref(x = 1) F(x); evaluator: the packed textures.
+  const FogEvaluator eval = MakeEvaluator(out);
+  ProductAccumulator acc[4];  // fog fit, fog eval, shadowed fit, shadowed eval
+  for (ProductAccumulator& a : acc) {
+    a.near_per_sun.resize(n_tab);
+    a.all_per_sun.resize(n_tab);
+  }
+  out.residual_fog_fit.assign(n_tab, std::vector<float>(ne * na * nx, kNaN));
+  out.residual_fog_eval = out.residual_shadowed_fit = out.residual_shadowed_eval = out.residual_fog_fit;
+  out.residual_fog_eval_rgb.assign(n_tab, std::vector<std::array<float, 3>>(ne * na * nx, {kNaN, kNaN, kNaN}));
+  double noise2 = 0.0;
+  size_t noise_n = 0;
+  for (size_t s = 0; s < n_tab; ++s) {
+    const double sza = render.tables[s].sun_zenith_deg;
+    for (size_t e = 0; e < ne; ++e) {
+      for (size_t az = 0; az < na; ++az) {
+        const std::array<double, 3> dir = DirOf(render.elevation_deg[e], render.azimuth_deg[az]);
+        const size_t i1 = render.TableIndex(e, az, nx - 1);
+        for (size_t j = 0; j < nx; ++j) {
+          const size_t i = render.TableIndex(e, az, j);
+          const double x = render.depth_x[j];
+          const double depth_m = x * depth_max[e];
+          const FogValue v = eval.Evaluate(dir, j + 1 == nx ? depth_max[e] * 2.0 : depth_m, sza * kDeg, 0.0);
+          const FogValue vs = eval.Evaluate(dir, j + 1 == nx ? depth_max[e] * 2.0 : depth_m, sza * kDeg, 1.0);
+          for (int prod = 0; prod < 2; ++prod) {
+            const std::vector<float>& d = prod ? ref_sh[s] : ref[s];
+            const std::array<double, 3> rc{d[i * 3], d[i * 3 + 1], d[i * 3 + 2]};
+            const std::array<double, 3> r1{d[i1 * 3], d[i1 * 3 + 1], d[i1 * 3 + 2]};
+            const double y_ref = Dot(y_row, rc);
+            if (!(y_ref > 0.0)) {
+              if (prod == 0) ++out.excluded_samples;
+              continue;
+            }
+            if (prod == 0 && render.tables[s].y_stderr[i] > 0.0f) {
+              const double rel = render.tables[s].y_stderr[i] / render.tables[s].xyz[i * 3 + 1];
+              noise2 += rel * rel;
+              ++noise_n;
+            }
+            std::array<double, 3> fit{}, ev = prod ? vs.inscattered : v.inscattered;
+            const std::array<double, 3>& a = prod ? par.a_shadowed : par.a;
+            const std::array<double, 3>& p = prod ? par.p_shadowed : par.p;
+            for (int c = 0; c < 3; ++c) fit[c] = r1[c] * DepthFactor(x, DepthExponent(a[c], p[c], theta[e]));
+            for (int src = 0; src < 2; ++src) {
+              const std::array<double, 3>& m = src ? ev : fit;
+              const double err = Dot(y_row, m) / y_ref - 1.0;
+              std::array<double, 3> ec;
+              for (int c = 0; c < 3; ++c) ec[c] = rc[c] > 0.0 ? m[c] / rc[c] - 1.0 : std::numeric_limits<double>::quiet_NaN();
+              ProductAccumulator& A = acc[prod * 2 + src];
+              const double elev = render.elevation_deg[e], azd = render.azimuth_deg[az];
+              A.all.Add(err, ec, sza, elev, azd, depth_m, x);
+              A.all_per_sun[s].Add(err, ec, sza, elev, azd, depth_m, x);
+              const bool near = depth_m <= o.near_depth_m, horizon = elev <= o.horizon_elevation_deg;
+              if (near) {
+                A.near.Add(err, ec, sza, elev, azd, depth_m, x);
+                A.near_per_sun[s].Add(err, ec, sza, elev, azd, depth_m, x);
+              } else {
+                A.far.Add(err, ec, sza, elev, azd, depth_m, x);
+              }
+              if (horizon) A.horizon.Add(err, ec, sza, elev, azd, depth_m, x);
+              if (near && horizon) A.near_horizon.Add(err, ec, sza, elev, azd, depth_m, x);
+              if (j + 1 == nx) A.infinite_depth.Add(err, ec, sza, elev, azd, depth_m, x);
+              std::vector<float>& map = prod ? (src ? out.residual_shadowed_eval[s] : out.residual_shadowed_fit[s])
+                                             : (src ? out.residual_fog_eval[s] : out.residual_fog_fit[s]);
+              map[i] = static_cast<float>(err);
+              if (prod == 0 && src == 1) {
+                out.residual_fog_eval_rgb[s][i] = {static_cast<float>(ec[0]), static_cast<float>(ec[1]), static_cast<float>(ec[2])};
+              }
+            }
+          }
+        }
+      }
+    }
+  }
+  out.fog_fit = acc[0].Done();
+  out.fog_eval = acc[1].Done();
+  out.shadowed_fit = acc[2].Done();
+  out.shadowed_eval = acc[3].Done();
+  out.reference_noise_rms = noise_n ? std::sqrt(noise2 / static_cast<double>(noise_n)) : 0.0;
+
+  // Attenuation LUT vs the exact transmittance at the depth tables' points.
+  std::array<double, 3> sum2{0, 0, 0};
+  size_t n = 0;
+  for (size_t e = 0; e < ne; ++e) {
+    for (size_t j = 0; j < nx; ++j) {
+      const std::array<float, 3> exact = t_rgb(&render.depth_transmittance[(e * nx + j) * nw]);
+      const FogValue v = eval.Evaluate(DirOf(render.elevation_deg[e], 0.0), render.depth_x[j] * depth_max[e], 0.0);
+      for (int c = 0; c < 3; ++c) {
+        const double d = std::fabs(v.transmittance[c] - exact[c]);
+        sum2[c] += d * d;
+        out.attenuation_max_abs[c] = std::max(out.attenuation_max_abs[c], d);
+      }
+      ++n;
+    }
+  }
+  for (int c = 0; c < 3; ++c) out.attenuation_rms_abs[c] = std::sqrt(sum2[c] / static_cast<double>(std::max<size_t>(n, 1)));
+  return out;
+}
+
+// ------------------------------------------------------------------------------------- encoding
+
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+std::string Join(const std::vector<double>& v) {
+  std::string s;
+  for (double x : v) s += (s.empty() ? "" : " ") + FormatExact(x);
+  return s;
+}
+
+std::string ModelText(const FogParams& p) {
+  return fmt::format(
+      "Fog(dir, d) = LUT(dir) (1 - exp(-a theta^p x)) / (1 - exp(-a theta^p)) per Linear Rec.2020 channel, "
+      "x = min(d / D, 1), D = distance from the observer to the cut sphere (altitude {} m) along dir, directions below "
+      "the horizon clamped to it; theta = {}; docs/fog.md",
+      FormatExact(p.cut_altitude_m),
+      p.angle == AngleDefinition::kPath ? "(cut - observer altitude) / D (path)" : "elevation / 90 deg (elevation)");
+}
+
+ExrImage InspectionImage(int width, int height, const lut::PackedTexture& t, const Provenance& prov, const std::string& quantity) {
+  const ExrImage colour = MakeColorImage(width, height, t.decoded_rgb, ocio_names::kLinearRec2020);
+  ExrImage img;
+  img.Resize(width, height, {"R", "G", "B", "input_R", "input_G", "input_B", "clamp_flags"});
+  const size_t n = static_cast<size_t>(width) * height;
+  for (size_t i = 0; i < n; ++i) {
+    for (int c = 0; c < 3; ++c) {
+      img.pixels[i * 7 + c] = t.decoded_rgb[i * 3 + c];
+      img.pixels[i * 7 + 3 + c] = t.input_rgb[i * 3 + c];
+    }
+    img.pixels[i * 7 + 6] = t.clamp_flags[i];
+  }
+  img.chromaticities = colour.chromaticities;
+  img.strings = colour.strings;
+  img.strings["skybake.quantity"] = quantity;
+  img.strings["skybake.channels"] =
+      "R, G, B: the packed texels as a shader reads them divided by the scale (physical units, Linear Rec.2020); "
+      "input_R/G/B: before packing; clamp_flags: 1 = above the format's largest value, 2 = negative (outside "
+      "Rec.2020), 4 = denormal (bit OR)";
+  img.doubles["skybake.scale"] = t.scale;
+  SetProvenance(img, prov);
+  return img;
+}
+
+Json StatsJson(const ErrorStats& s) {
+  return Json{{"samples", s.count},
+              {"rms", s.rms},
+              {"max", s.max},
+              {"channel_rms", {{"R", s.channel_rms[0]}, {"G", s.channel_rms[1]}, {"B", s.channel_rms[2]}}},
+              {"max_at",
+               {{"sun_zenith_deg", s.max_sun_zenith_deg},
+                {"elevation_deg", s.max_elevation_deg},
+                {"azimuth_from_sun_deg", s.max_azimuth_deg},
+                {"depth_m", s.max_depth_m},
+                {"x", s.max_x}}}};
+}
+
+Json ProductJson(const ProductStats& p, const FogRender& r) {
+  Json j;
+  j["all"] = StatsJson(p.all);
+  j["near_camera"] = StatsJson(p.near);
+  j["far"] = StatsJson(p.far);
+  j["horizon"] = StatsJson(p.horizon);
+  j["near_camera_at_horizon"] = StatsJson(p.near_horizon);
+  j["infinite_depth"] = StatsJson(p.infinite_depth);
+  Json per = Json::array();
+  for (size_t s = 0; s < r.tables.size(); ++s) {
+    per.push_back({{"sun_zenith_deg", r.tables[s].sun_zenith_deg},
+                   {"rms", p.all_per_sun[s].rms},
+                   {"max", p.all_per_sun[s].max},
+                   {"near_camera_rms", p.near_per_sun[s].rms},
+                   {"near_camera_max", p.near_per_sun[s].max}});
+  }
+  j["per_sun"] = per;
+  return j;
+}
+
+Json FitJson(const std::array<FitResult, 3>& f, bool per_channel) {
+  Json j = Json::array();
+  for (int c = 0; c < (per_channel ? 3 : 1); ++c) {
+    j.push_back({{"channel", per_channel ? std::string(1, "RGB"[c]) : std::string("luminance")},
+                 {"a", f[c].a},
+                 {"p", f[c].p},
+                 {"rms_log_residual", f[c].rms_log},
+                 {"samples_used", f[c].used},
+                 {"samples_left_out", f[c].rejected},
+                 {"evaluations", f[c].evaluations},
+                 {"p_fitted", f[c].p_fitted},
+                 {"at_bound", f[c].at_bound},
+                 {"fallback", f[c].fallback},
+                 {"status", f[c].status}});
+  }
+  return j;
+}
+
+Json PackJson(const lut::PackedTexture& t) {
+  const lut::PackStats& s = t.stats;
+  return Json{{"size", {t.width, t.height, t.depth}},
+              {"scale", t.scale},
+              {"texels", s.texels},
+              {"clamped_above_max", s.clamped_high},
+              {"negative_rec2020", s.negative_texels},
+              {"denormal", s.denormal_texels},
+              {"luminance_relative_error_rms", s.y_rel_rms},
+              {"luminance_relative_error_max", s.y_rel_max}};
+}
+
+Json ProvenanceJson(const Provenance& p) {
+  Json in = Json::array();
+  for (const auto& [path, hash] : p.inputs) in.push_back({{"path", path}, {"xxh3", hash}});
+  return Json{{"tool", p.tool}, {"version", kVersion}, {"parameters", p.parameters}, {"inputs", in}};
+}
+
+// Diverging colours for a relative error: blue (-range) - white (0) - red (+range); grey = excluded.
+std::array<uint8_t, 3> Diverging(float e, double range) {
+  if (!std::isfinite(e)) return {96, 96, 96};
+  const double t = std::clamp(e / range, -1.0, 1.0);
+  const double lo[3] = {59, 76, 192}, hi[3] = {180, 4, 38};  // Moreland's cool-warm ends (sRGB codes)
+  std::array<uint8_t, 3> c;
+  for (int k = 0; k < 3; ++k) {
+    const double end = t < 0 ? lo[k] : hi[k];
+    c[k] = static_cast<uint8_t>(std::lround(255.0 + (end - 255.0) * std::fabs(t)));
+  }
+  return c;
+}
+
+}  // namespace
+
+std::vector<std::string> FogProductFiles(const std::string& P) {
+  return {P + ".json",         P + ".ktx2",          P + "_array.ktx2",          P + ".dds",
+          P + "_shadowed.ktx2", P + "_shadowed_array.ktx2", P + "_shadowed.dds", P + "_attenuation.ktx2",
+          P + "_attenuation.dds", P + ".exr",         P + "_report.json",         P + "_residuals.exr",
+          P + "_residuals.png"};
+}
+
+std::map<std::string, std::string> EncodeFogProducts(const FogRender& r, const FogProducts& p, const std::string& P,
+                                                     const Provenance& prov) {
+  std::map<std::string, std::string> out;
+  const FogGeometry geo = r.geometry();
+  // ---- Fog and shadowed fog LUTs: lut-pack's sky texture layout and keys (lut::SkyKtx2), so that
+  // lut::SkyLutDecoder reads them; the quantity and the night rule are the fog's.
+  lut::LutSet set;
+  set.options.night_end_zenith_deg = p.options.night_end_zenith_deg;
+  auto fog_ktx2 = [&](const lut::PackedTexture& t, bool shadowed, bool array) {
+    lut::SkyLutProduct sp;
+    sp.name = p.sky;
+    sp.render = &p.layout;
+    sp.sky = t;
+    sp.night_rgb = {0, 0, 0};
+    ktx2::Texture tex = lut::SkyKtx2(set, sp, array, prov);
+    ktx2::SetString(tex, "skybake.quantity",
+                    std::string(shadowed ? "shadowed fog (no single-scattered sun)" : "fog") +
+                        " of the whole low-atmosphere segment (x = 1): in-scattered radiance (cd/m^2 of luminance) in "
+                        "Linear Rec.2020, times skybake.scale; texel (x, y, slice) is the direction of the GT7 sphere "
+                        "mapping at u = (x + 1/2)/W, v = (y + 1/2)/H for the sun zenith angle of the slice; directions "
+                        "below the horizon hold the horizon's value");
+    ktx2::SetString(tex, "skybake.night",
+                    fmt::format("below the last slice (sun zenith {} deg) the decoded fog moves linearly to 0, reached at "
+                                "sun zenith {} deg",
+                                FormatExact(r.slice_zenith_deg.back()), FormatExact(p.options.night_end_zenith_deg)));
+    ktx2::SetString(tex, "skybake.fog.model", ModelText(p.params));
+    ktx2::SetString(tex, "skybake.fog.cut_altitude_m", FormatExact(r.cut_altitude_m));
+    ktx2::SetString(tex, "skybake.fog.parameters", P + ".json");
+    return ktx2::EncodeKtx2(tex);
+  };
+  auto dds = [](const lut::PackedTexture& t, bool volume) {
+    dds::Texture d;
+    d.width = static_cast<uint32_t>(t.width);
+    d.height = static_cast<uint32_t>(t.height);
+    d.depth = volume ? static_cast<uint32_t>(t.depth) : 0;
+    d.data = t.bytes;
+    return dds::EncodeDds(d);
+  };
+  out[P + ".ktx2"] = fog_ktx2(p.fog, false, false);
+  out[P + "_array.ktx2"] = fog_ktx2(p.fog, false, true);
+  out[P + ".dds"] = dds(p.fog, true);
+  out[P + "_shadowed.ktx2"] = fog_ktx2(p.shadowed, true, false);
+  out[P + "_shadowed_array.ktx2"] = fog_ktx2(p.shadowed, true, true);
+  out[P + "_shadowed.dds"] = dds(p.shadowed, true);
+  const std::string att_quantity =
+      "transmittance from the observer to normalised depth x along the view, for sunlight, per Linear Rec.2020 channel: "
+      "[E0 T]_c / [E0]_c (1), times skybake.scale";
+  const std::string att_axes =
+      "u = x^(1/3) (x = depth / D, D the distance to the cut sphere), v = (elevation / 90 deg)^(1/2) (below the horizon: "
+      "0); texel (i, j) is the node u = i/(W-1), v = j/(H-1): sample at ((u (W-1) + 1/2)/W, (v (H-1) + 1/2)/H), "
+      "bilinear, clamp to edge";
+  {
+    ktx2::Texture tex;
+    tex.format = ktx2::B10G11R11UfloatPack32();
+    tex.width = static_cast<uint32_t>(p.attenuation.width);
+    tex.height = static_cast<uint32_t>(p.attenuation.height);
+    ktx2::SetProvenance(tex, prov);
+    ktx2::SetString(tex, "KTXorientation", "rd");
+    ktx2::SetString(tex, "skybake.basis_sky", p.sky);
+    ktx2::SetString(tex, "skybake.quantity", att_quantity);
+    ktx2::SetString(tex, "skybake.colorspace", ocio_names::kLinearRec2020);
+    ktx2::SetString(tex, "skybake.scale", FormatExact(p.attenuation.scale));
+    ktx2::SetString(tex, "skybake.sampling", att_axes);
+    ktx2::SetString(tex, "skybake.fog.cut_altitude_m", FormatExact(r.cut_altitude_m));
+    ktx2::SetString(tex, "skybake.fog.observer_altitude_m", FormatExact(r.observer_altitude_m));
+    ktx2::SetString(tex, "skybake.fog.planet_radius_m", FormatExact(r.planet_radius_m));
+    tex.data = p.attenuation.bytes;
+    out[P + "_attenuation.ktx2"] = ktx2::EncodeKtx2(tex);
+  }
+  out[P + "_attenuation.dds"] = dds(p.attenuation, false);
+
+  // ---- Inspection EXR.
+  {
+    std::vector<ExrPart> parts;
+    const std::string layout = fmt::format("{} slices of {}x{} stacked top to bottom", p.fog.depth, p.fog.width, p.fog.height);
+    ExrImage f = InspectionImage(p.fog.width, p.fog.height * p.fog.depth, p.fog, prov, "fog LUT (x = 1), cd/m^2");
+    f.strings["skybake.layout"] = layout;
+    f.strings["skybake.slice_zenith_deg"] = Join(r.slice_zenith_deg);
+    ExrImage s = InspectionImage(p.shadowed.width, p.shadowed.height * p.shadowed.depth, p.shadowed, prov,
+                                 "shadowed fog LUT (x = 1), cd/m^2");
+    s.strings["skybake.layout"] = layout;
+    s.strings["skybake.slice_zenith_deg"] = Join(r.slice_zenith_deg);
+    ExrImage a = InspectionImage(p.attenuation.width, p.attenuation.height, p.attenuation, prov, att_quantity);
+    a.strings["skybake.sampling"] = att_axes;
+    parts.push_back({"fog", std::move(f)});
+    parts.push_back({"shadowed", std::move(s)});
+    parts.push_back({"attenuation", std::move(a)});
+    out[P + ".exr"] = EncodeExrParts(parts);
+  }
+
+  // ---- Parameters.
+  {
+    Json j;
+    j["basis_sky"] = p.sky;
+    Json m;
+    m["equation"] = ModelText(p.params);
+    m["angle"] = AngleDefinitionName(p.params.angle);
+    m["channels"] = p.options.per_channel ? "rgb (one a, p per Linear Rec.2020 channel)" : "luminance (one a, p for R, G, B)";
+    m["colorspace"] = ocio_names::kLinearRec2020;
+    m["planet_radius_m"] = p.params.planet_radius_m;
+    m["observer_altitude_m"] = p.params.observer_altitude_m;
+    m["cut_altitude_m"] = p.params.cut_altitude_m;
+    m["boundary_distance_zenith_m"] = geo.BoundaryDistanceM(1.0);
+    m["boundary_distance_horizon_m"] = geo.BoundaryDistanceM(0.0);
+    m["units"] = "a, p, x and theta are dimensionless; depths in m; LUT radiance in cd/m^2 (Linear Rec.2020)";
+    m["fog"] = {{"a", p.params.a}, {"p", p.params.p}};
+    m["shadowed"] = {{"a", p.params.a_shadowed}, {"p", p.params.p_shadowed}};
+    j["model"] = m;
+    j["files"] = {{"fog", P + ".ktx2"},
+                  {"fog_array", P + "_array.ktx2"},
+                  {"fog_dds", P + ".dds"},
+                  {"shadowed", P + "_shadowed.ktx2"},
+                  {"shadowed_array", P + "_shadowed_array.ktx2"},
+                  {"shadowed_dds", P + "_shadowed.dds"},
+                  {"attenuation", P + "_attenuation.ktx2"},
+                  {"attenuation_dds", P + "_attenuation.dds"},
+                  {"report", P + "_report.json"}};
+    j["skybake"] = ProvenanceJson(prov);
+    out[P + ".json"] = j.dump(2) + "\n";
+  }
+
+  // ---- Report.
+  {
+    Json j;
+    j["basis_sky"] = p.sky;
+    j["reference"] = {{"file", r.path},
+                      {"method", r.method},
+                      {"method_settings", r.method_description},
+                      {"sun_zenith_deg", [&] {
+                         std::vector<double> v;
+                         for (const FogDepthTable& t : r.tables) v.push_back(t.sun_zenith_deg);
+                         return v;
+                       }()},
+                      {"elevation_deg", r.elevation_deg},
+                      {"azimuth_from_sun_deg", r.azimuth_deg},
+                      {"depth_x", r.depth_x},
+                      {"noise_rms_relative", p.reference_noise_rms},
+                      {"samples_with_zero_fog", p.excluded_samples}};
+    j["definitions"] = {
+        {"error", "relative luminance error Y_model / Y_reference - 1 (Y from Linear Rec.2020 by OCIO); channel_rms: the "
+                  "same per Rec.2020 channel"},
+        {"fit", "the model with the exact reference at x = 1: LUT(dir) = Fog_ref(dir, 1) (the depth function's error)"},
+        {"evaluator", "fog/fog_evaluator.h on the packed textures: mappings, slice interpolation, R11G11B10F and the depth "
+                      "function (what a game gets)"},
+        {"near_camera", fmt::format("depth <= {} m", FormatExact(p.options.near_depth_m))},
+        {"horizon", fmt::format("elevation <= {} deg", FormatExact(p.options.horizon_elevation_deg))},
+        {"infinite_depth", "x = 1: the LUT against the direct render of the same directions (consistency)"}};
+    j["fit"] = {{"angle", AngleDefinitionName(p.params.angle)},
+                {"fog", FitJson(p.fit_fog, p.options.per_channel)},
+                {"shadowed", FitJson(p.fit_shadowed, p.options.per_channel)}};
+    j["errors"] = {{"fog", {{"fit", ProductJson(p.fog_fit, r)}, {"evaluator", ProductJson(p.fog_eval, r)}}},
+                   {"shadowed", {{"fit", ProductJson(p.shadowed_fit, r)}, {"evaluator", ProductJson(p.shadowed_eval, r)}}}};
+    j["attenuation"] = {{"rms_abs", {{"R", p.attenuation_rms_abs[0]}, {"G", p.attenuation_rms_abs[1]}, {"B", p.attenuation_rms_abs[2]}}},
+                        {"max_abs", {{"R", p.attenuation_max_abs[0]}, {"G", p.attenuation_max_abs[1]}, {"B", p.attenuation_max_abs[2]}}}};
+    j["packing"] = {{"fog", PackJson(p.fog)}, {"shadowed", PackJson(p.shadowed)}, {"attenuation", PackJson(p.attenuation)}};
+    j["skybake"] = ProvenanceJson(prov);
+    out[P + "_report.json"] = j.dump(2) + "\n";
+  }
+
+  // ---- Residual maps.
+  {
+    std::vector<ExrPart> parts;
+    const ExrAxis dx{"depth_x", "1", "normalised depth x", r.depth_x};
+    const ExrAxis az{"azimuth", "deg", "view azimuth from the sun", r.azimuth_deg};
+    const ExrAxis el{"elevation", "deg", "view elevation", r.elevation_deg};
+    for (size_t s = 0; s < r.tables.size(); ++s) {
+      ExrTable t;
+      t.axes = {dx, az, el};
+      t.channels = {"fog_fit_Y", "fog_eval_Y", "shadowed_fit_Y", "shadowed_eval_Y", "fog_eval_R", "fog_eval_G", "fog_eval_B", "depth_m"};
+      t.channel_units = {"1", "1", "1", "1", "1", "1", "1", "m"};
+      const size_t n = p.residual_fog_fit[s].size();
+      for (size_t i = 0; i < n; ++i) {
+        const size_t e = i / (r.azimuth_deg.size() * r.depth_x.size()), j = i % r.depth_x.size();
+        const double depth = r.depth_x[j] * geo.BoundaryDistanceM(std::sin(r.elevation_deg[e] * kDeg));
+        for (float v : {p.residual_fog_fit[s][i], p.residual_fog_eval[s][i], p.residual_shadowed_fit[s][i],
+                        p.residual_shadowed_eval[s][i], p.residual_fog_eval_rgb[s][i][0], p.residual_fog_eval_rgb[s][i][1],
+                        p.residual_fog_eval_rgb[s][i][2], static_cast<float>(depth)}) {
+          t.values.push_back(v);
+        }
+      }
+      ExrImage img = TableToImage(t);
+      img.strings["skybake.quantity"] =
+          "relative error of the fog model vs the reference (Y_model / Y_ref - 1; NaN where the reference is 0): fit = "
+          "exact LUT x depth function, eval = the evaluator on the packed textures";
+      img.doubles["skybake.sun_zenith_deg"] = r.tables[s].sun_zenith_deg;
+      SetProvenance(img, prov);
+      parts.push_back({fmt::format("residual.sza_{:06.2f}", r.tables[s].sun_zenith_deg), std::move(img)});
+    }
+    out[P + "_residuals.exr"] = EncodeExrParts(parts);
+
+    // PNG: one tile per (sun: rows) x (azimuth: columns), depth x to the right (near camera at the
+    // left), elevation upwards (horizon at the bottom row); fog on the left, shadowed fog on the
+    // right; 4 x 4 pixels per sample; +-10 % full scale (white = 0, red = too bright, blue = too dark).
+    constexpr int kPx = 4, kGap = 2;
+    const int nx = static_cast<int>(r.depth_x.size()), ne = static_cast<int>(r.elevation_deg.size());
+    const int na = static_cast<int>(r.azimuth_deg.size()), ns = static_cast<int>(r.tables.size());
+    const int tile_w = nx * kPx, tile_h = ne * kPx;
+    const int block_w = na * (tile_w + kGap);
+    const int W = 2 * block_w + 4 * kGap, H = ns * (tile_h + kGap) + kGap + 3 * kPx;
+    std::vector<uint8_t> px(static_cast<size_t>(W) * H * 3, 32);
+    auto put = [&](int x, int y, std::array<uint8_t, 3> c) {
+      for (int k = 0; k < 3; ++k) px[(static_cast<size_t>(y) * W + x) * 3 + k] = c[k];
+    };
+    for (int prod = 0; prod < 2; ++prod) {
+      const auto& maps = prod ? p.residual_shadowed_eval : p.residual_fog_eval;
+      for (int s = 0; s < ns; ++s) {
+        for (int a = 0; a < na; ++a) {
+          const int x0 = prod * (block_w + 4 * kGap) + a * (tile_w + kGap), y0 = s * (tile_h + kGap);
+          for (int e = 0; e < ne; ++e) {
+            for (int j = 0; j < nx; ++j) {
+              const auto c = Diverging(maps[s][r.TableIndex(e, a, j)], 0.1);
+              for (int dy = 0; dy < kPx; ++dy) {
+                for (int dxp = 0; dxp < kPx; ++dxp) put(x0 + j * kPx + dxp, y0 + (ne - 1 - e) * kPx + dy, c);
+              }
+            }
+          }
+        }
+      }
+    }
+    // Colour bar along the bottom: -10 % at the left to +10 % at the right.
+    for (int x = 0; x < W; ++x) {
+      const auto c = Diverging(static_cast<float>(-0.1 + 0.2 * x / std::max(1, W - 1)), 0.1);
+      for (int y = H - 2 * kPx; y < H; ++y) put(x, y, c);
+    }
+    out[P + "_residuals.png"] = EncodePng8(W, H, 3, px);
+  }
+  return out;
+}
+
+}  // namespace skybake::fog
