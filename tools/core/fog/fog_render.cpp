@@ -59,7 +59,7 @@ class SegmentRenderer {
       if (!method_->SupportsSegments()) {
         throw UsageError("--method " + o.method + " does not render view segments (fog); use orders or path");
       }
-      description_ = "method: " + o.method + "\n" + method_->Describe();
+      description_ = method_->Describe();  // YAML starting with "method: <name>"
     }
   }
   const std::string& description() const { return description_; }
