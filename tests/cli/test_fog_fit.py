@@ -57,7 +57,7 @@ class FogFitCli(CliContract, TempDirTestCase):
             self.assertIn(part, dump.stdout)
         attrs = exr_attributes(self.fog)  # the first part
         self.assertEqual(attrs["skybake.tool"], "sky-render")
-        self.assertEqual(attrs["skybake.fog.cut_altitude_m"], 3500.0)
+        self.assertEqual(attrs["skybake.fog.cut_altitude_m"], 1000.0)
         self.assertIn("subcommand: fog", attrs["skybake.parameters"])
 
     def test_products_read_back(self):
@@ -88,7 +88,7 @@ class FogFitCli(CliContract, TempDirTestCase):
         info = ktx_parse(self.path("fog_plain.ktx2"))
         self.assertEqual((info["vkFormat"], info["pixelWidth"], info["pixelHeight"], info["pixelDepth"]), (122, 4, 8, 5))
         self.assertIn("fog of the whole low-atmosphere segment", info["keyValue"]["skybake.quantity"])
-        self.assertEqual(info["keyValue"]["skybake.fog.cut_altitude_m"], "3500")
+        self.assertEqual(info["keyValue"]["skybake.fog.cut_altitude_m"], "1000")
         fog = texels(ktx_level(self.path("fog_plain.ktx2"), info))
         shadowed = texels(ktx_level(self.path("fog_plain_shadowed.ktx2"), ktx_parse(self.path("fog_plain_shadowed.ktx2"))))
         self.assertEqual(len(fog), 4 * 8 * 5)

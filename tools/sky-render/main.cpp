@@ -6,7 +6,7 @@
 //              [--sun-zenith-deg 30,70,85,90,94 | --time-mapping gt7] [--target-error 0.01] [--preview sky.png] ...
 //   sky-render points ATMOSPHERE.yaml --geometry in.csv -o out.csv [--wavelengths-out 440,550,680]
 //   sky-render budget ATMOSPHERE.yaml -o budget.csv [--tolerance 1%] [--method ms-approx] ...
-//   sky-render fog ATMOSPHERE.yaml -o fog.exr [--method orders|path] [--cut-altitude-km 3.5] ... (docs/fog.md)
+//   sky-render fog ATMOSPHERE.yaml -o fog.exr [--method orders|path] [--cut-altitude-km 1] ... (docs/fog.md)
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -119,13 +119,13 @@ int main(int argc, char** argv) {
       "fog", "Reference fog of the low atmosphere: GT7 fog LUT slices, depth tables, attenuation (docs/fog.md)");
   add_scene_options(fog);
   fog::FogRenderOptions fo;
-  double cut_km = 3.5;
+  double cut_km = 1.0;
   std::string lut_size = "32x32", att_size = "64x64";
   fog->add_option("--method", fo.method, "orders (deterministic, all orders) or path (the Monte-Carlo reference)")
       ->default_val("orders");
   fog->add_option("--quality", fo.method_options.quality, "orders: low, medium or high")->default_val("medium");
   fog->add_option("--cut-altitude-km", cut_km, "Top of the low atmosphere that scatters into the fog (km; docs/fog.md)")
-      ->default_val(3.5);
+      ->default_val(1.0);
   fog->add_option("--observer-altitude-m", fo.observer_altitude_m, "Override the atmosphere's observer altitude (m)");
   fog->add_option("--lut-size", lut_size, "Fog LUT slices on the GT7 sphere mapping, WxH")->default_val("32x32");
   fog->add_option("--time-mapping", fo.time_mapping, "GT7 time mapping of the slices: gt7, gt7-quadratic[:<upper>+<lower>]")

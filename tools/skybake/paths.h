@@ -39,6 +39,19 @@ inline std::vector<std::string> LutSetFiles() {
   return {"transmittance.ktx2", "transmittance.dds", "sun.ktx2", "sun.dds", "ambient.ktx2", "ambient.dds", "other_luts.exr"};
 }
 
+// outputs/<atm>/fog.exr: sky-render fog (the reference fog of the low atmosphere) for fog-fit.
+inline std::filesystem::path FogRender(const std::string& atm) { return std::filesystem::path(atm) / "fog.exr"; }
+// outputs/fog/fog_<sky>.json: fog-fit's parameter file; the sky's other fog products lie beside it.
+inline std::filesystem::path FogParams(const std::string& sky) { return std::filesystem::path("fog") / ("fog_" + sky + ".json"); }
+inline std::filesystem::path FogFile(const std::string& name) { return std::filesystem::path("fog") / name; }
+// The files fog-fit writes per basis sky besides the parameter file (fog/fog_luts.h FogProductFiles).
+inline std::vector<std::string> FogSkyFiles(const std::string& sky) {
+  const std::string p = "fog_" + sky;
+  return {p + ".ktx2",          p + "_array.ktx2",      p + ".dds",           p + "_shadowed.ktx2",
+          p + "_shadowed_array.ktx2", p + "_shadowed.dds", p + "_attenuation.ktx2", p + "_attenuation.dds",
+          p + ".exr",           p + "_report.json",     p + "_residuals.exr", p + "_residuals.png"};
+}
+
 // outputs/components/particles/<type>.yaml: the canonical component of a particle type (its
 // file's stem), shared by every atmosphere that uses the type.
 inline std::filesystem::path ParticleComponent(const std::string& type) {

@@ -9,6 +9,7 @@ std::unique_ptr<Stage> MakeSkyRenderStage();
 std::unique_ptr<Stage> MakeNoiseGenStage();
 std::unique_ptr<Stage> MakeCumulusMapStage();
 std::unique_ptr<Stage> MakeLutPackStage();
+std::unique_ptr<Stage> MakeFogFitStage();
 
 std::vector<std::unique_ptr<Stage>> MakeStages() {
   std::vector<std::unique_ptr<Stage>> s;
@@ -16,6 +17,7 @@ std::vector<std::unique_ptr<Stage>> MakeStages() {
   s.push_back(MakeMieTablesStage());
   s.push_back(MakeSkyRenderStage());
   s.push_back(MakeLutPackStage());  // after sky-render: uses its render components
+  s.push_back(MakeFogFitStage());   // after sky-render: uses its render components
   s.push_back(MakeNoiseGenStage());
   s.push_back(MakeCumulusMapStage());  // after noise-gen: it owns the `clouds` section's unknown keys
   return s;

@@ -34,7 +34,7 @@ namespace skybake::fog {
 struct FogParams {
   std::string basis_sky;
   AngleDefinition angle = AngleDefinition::kPath;
-  double planet_radius_m = 6371e3, observer_altitude_m = 0.0, cut_altitude_m = 3500.0;
+  double planet_radius_m = 6371e3, observer_altitude_m = 0.0, cut_altitude_m = 1000.0;
   std::array<double, 3> a{1, 1, 1}, p{0, 0, 0};                    // fog, per Linear Rec.2020 channel
   std::array<double, 3> a_shadowed{1, 1, 1}, p_shadowed{0, 0, 0};  // shadowed fog
   FogGeometry geometry() const { return FogGeometry(planet_radius_m, observer_altitude_m, cut_altitude_m); }

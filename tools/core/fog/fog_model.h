@@ -9,7 +9,8 @@
 //   mu_c = max(mu, 0)                                                    (docs/fog.md, "Below the horizon")
 // and its boundary distance is the path from the observer to the cut sphere,
 //   D(mu) = -r mu_c + sqrt(r^2 mu_c^2 + r_c^2 - r^2)                  (ray-sphere, far root)
-// (D(1) = c - h straight up, D(0) = sqrt(r_c^2 - r^2) along the horizon: 211 km for c = 3.5 km).
+// (D(1) = c - h straight up, D(0) = sqrt(r_c^2 - r^2) along the horizon: 112.9 km for c = 1 km,
+// 211.2 km for c = 3.5 km).
 // An object at distance d (m) along the view has the normalised depth
 //   x = min(d / D(mu), 1)                                               (the talk's "normalized depth")
 // and the fog (radiance in-scattered between the observer and the object) is modelled as
@@ -17,8 +18,8 @@
 //   F(x, k) = (1 - exp(-k x)) / (1 - exp(-k))                         (the talk's equation)
 // with LUT = the fog of the whole segment (x = 1) and theta the normalised view angle:
 //   elevation:  theta = asin(mu_c) / (pi/2)                             (the talk's "normalized theta")
-//   path:       theta = (r_c - r) / D(mu)  = sin(elevation) on a flat planet, (c - h)/D(0) = 0.0166
-//               at the horizon for c = 3.5 km (skybake's default; docs/fog.md, "Which theta")
+//   path:       theta = (r_c - r) / D(mu)  = sin(elevation) on a flat planet, (c - h)/D(0) = 0.0089
+//               at the horizon for c = 1 km (skybake's default cut; docs/fog.md, "Which theta")
 // For a homogeneous low atmosphere of extinction sigma lit uniformly, Fog(x)/Fog(1) is exactly
 // F(x, sigma D) and sigma D = sigma (c - h) / theta_path: the model with theta_path, p = -1 and
 // a = sigma (c - h) is exact, on the sphere and at the horizon; with theta_elevation it diverges

@@ -38,7 +38,7 @@ namespace skybake::fog {
 struct FogRenderOptions {
   std::string method = "orders";  // "orders" or "path"
   SkyMethodOptions method_options;
-  double cut_altitude_m = 3500.0;
+  double cut_altitude_m = 1000.0;
   double observer_altitude_m = -1.0;  // < 0: the atmosphere's
   // LUT slices: GT7 sphere mapping W x H, GT7 time mapping name (lut/gt7_mapping.h).
   int lut_width = 32, lut_height = 32;

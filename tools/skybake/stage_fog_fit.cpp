@@ -1,0 +1,183 @@
+// fog-fit edges: GT7 global fog of the basis skies (docs/fog.md; ../shared/seeds/gt7-sky-talk.txt,
+// "Fog").
+//
+//   outputs/<atm>/fog.exr             sky-render fog: the reference fog of the low atmosphere (LUT
+//                                     slices, depth tables, attenuation nodes) of one basis sky
+//   outputs/fog/fog_<atm>.json        fog-fit fit of that render, with beside it the sky's fog,
+//   outputs/fog/fog_<atm>*.ktx2 ...   shadowed fog and attenuation LUTs, report and residual maps
+//
+// Only with a `fog` section in pipeline.yaml:
+//   fog:
+//     method: orders               # sky-render fog method (orders or path)
+//     quality: medium              # orders quality preset
+//     cut_altitude_km: 1           # top of the low atmosphere (docs/fog.md, "The cut")
+//     time_mapping: gt7-quadratic  # GT7 time mapping of the fog LUT slices (as luts.time_mapping)
+//     lut_size: 32x32              # fog LUT slice W x H (GT7: 32 x 32 x 64)
+//     attenuation_size: 64x64      # attenuation LUT (GT7: 64 x 64)
+//     depth_tables: {sun_zenith_deg: [...], elevations: 9, azimuths_deg: [...], depths: 16}
+//     angle: path                  # the fit's normalised angle: path or elevation (the talk's)
+//     channels: rgb                # a, p per channel, or one for all (luminance)
+//     skies: [clear, hazed]        # atmospheres of the list above
+// One render edge and one fit edge per sky: an edit to one atmosphere re-runs only its two edges
+// (every fit writes only its own sky's files; write-if-changed + restat).
+#include <fmt/format.h>
+
+#include <set>
+
+#include "atmosphere/spec.h"
+#include "paths.h"
+#include "stage.h"
+
+namespace skybake {
+
+namespace {
+
+class FogFitStage : public Stage {
+ public:
+  std::string tool() const override { return "fog-fit"; }
+
+  void ParseConfig(YamlMap& root) override {
+    std::optional<YamlMap> fog = root.OptionalMap("fog");
+    if (!fog) return;
+    enabled_ = true;
+    method_ = fog->ChoiceOr("method", {"orders", "path"}, method_);
+    quality_ = fog->ChoiceOr("quality", {"low", "medium", "high"}, quality_);
+    cut_km_ = fog->NumberOr("cut_altitude_km", NumberSpec::Range(0.001, 100.0, "km"), cut_km_);
+    if (std::optional<YamlNode> tm = fog->Get("time_mapping")) {
+      if (std::optional<std::string> s = tm->ToString()) {
+        if (!Gt7NameOk(*s)) {
+          tm->ErrorExpected("gt7 or gt7-quadratic, optionally with :<upper>+<lower> slices (e.g. gt7:3+2)");
+        } else {
+          time_mapping_ = *s;
+        }
+      }
+    }
+    lut_size_ = Size(*fog, "lut_size", lut_size_);
+    attenuation_size_ = Size(*fog, "attenuation_size", attenuation_size_);
+    if (std::optional<YamlMap> t = fog->OptionalMap("depth_tables")) {
+      if (t->Has("sun_zenith_deg")) sun_zenith_deg_ = t->NumberList("sun_zenith_deg", NumberSpec::Range(0, 180, "deg"));
+      if (t->Has("azimuths_deg")) azimuths_deg_ = t->NumberList("azimuths_deg", NumberSpec::Range(0, 180, "deg"));
+      elevations_ = static_cast<int>(t->IntegerOr("elevations", 2, 1000, "a whole number of elevations from 2 to 1000", elevations_));
+      depths_ = static_cast<int>(t->IntegerOr("depths", 2, 1000, "a whole number of depths from 2 to 1000", depths_));
+      if (sun_zenith_deg_.empty()) t->node().Error("fog.depth_tables.sun_zenith_deg: expected at least one angle");
+      if (azimuths_deg_.empty()) t->node().Error("fog.depth_tables.azimuths_deg: expected at least one angle");
+      t->Finish();
+    }
+    angle_ = fog->ChoiceOr("angle", {"path", "elevation"}, angle_);
+    channels_ = fog->ChoiceOr("channels", {"rgb", "luminance"}, channels_);
+    std::set<std::string> seen;
+    for (const YamlNode& n : fog->Seq("skies")) {
+      const std::optional<std::string> s = n.ToString("the name of an atmosphere of the list above");
+      if (!s) continue;
+      if (!seen.insert(*s).second) n.Error("basis sky '" + *s + "' is listed twice");
+      skies_.push_back({*s, n.loc()});
+    }
+    if (skies_.empty()) fog->node().Error("fog.skies: expected at least one basis sky");
+    fog->Finish();
+  }
+
+  void EmitRules(GenContext& ctx) const override {
+    if (!enabled_) return;
+    const std::string pool = ctx.pipeline().pools.count("render") ? "render" : "";
+    ctx.ninja().Rule(ToolRule(ctx, "fog_render", "sky-render", pool));
+    ctx.ninja().Rule(ToolRule(ctx, "fog_fit", tool(), ""));
+  }
+
+  void EmitEdges(GenContext& ctx) const override {
+    if (!enabled_) return;
+    const auto& wl = ctx.pipeline().wavelengths;
+    Diagnostics diags;
+    auto join = [](const std::vector<double>& v) {
+      std::string s;
+      for (double x : v) s += (s.empty() ? "" : ",") + FormatExact(x);
+      return s;
+    };
+    for (const auto& [name, loc] : skies_) {
+      const PipelineAtmosphere* a = nullptr;
+      for (const PipelineAtmosphere& p : ctx.pipeline().atmospheres) {
+        if (p.name == name) a = &p;
+      }
+      if (!a) {
+        std::string names;
+        for (const PipelineAtmosphere& p : ctx.pipeline().atmospheres) names += (names.empty() ? "" : ", ") + p.name;
+        diags.Add(loc, "fog.skies: '" + name + "' is not an atmosphere of this pipeline (" + names + ")");
+        continue;
+      }
+      NinjaBuild r;
+      r.outputs = {paths::FogRender(a->name).generic_string()};
+      r.rule = "fog_render";
+      r.inputs = {paths::RenderComponent(a->name).generic_string()};
+      r.implicit_inputs = {ctx.ToolPath("sky-render"), paths::Profiles(a->name).generic_string()};
+      std::set<std::string> particles;
+      for (const AerosolLayerSpec& layer : a->spec.aerosols) {
+        if (layer.particle) particles.insert(layer.particle->stem().string());
+      }
+      for (const std::string& p : particles) r.implicit_inputs.push_back(paths::MieTable(p).generic_string());
+      r.variables = {{"args", fmt::format("fog --method {} --quality {} --profiles {} --mie-dir mie --wavelengths {}:{}:{} "
+                                          "--cut-altitude-km {} --lut-size {} --time-mapping {} --attenuation-size {} "
+                                          "--sun-zenith-deg {} --elevations {} --azimuths-deg {} --depths {}",
+                                          method_, quality_, paths::Profiles(a->name).generic_string(),
+                                          FormatExact(wl.min_nm), FormatExact(wl.max_nm), FormatExact(wl.step_nm),
+                                          FormatExact(cut_km_), lut_size_, time_mapping_, attenuation_size_,
+                                          join(sun_zenith_deg_), elevations_, join(azimuths_deg_), depths_)}};
+      ctx.Build("sky-render", r);
+
+      NinjaBuild f;
+      f.outputs = {paths::FogParams(a->name).generic_string()};
+      for (const std::string& file : paths::FogSkyFiles(a->name)) f.implicit_outputs.push_back(paths::FogFile(file).generic_string());
+      f.rule = "fog_fit";
+      f.inputs = r.outputs;
+      f.implicit_inputs = {ctx.ToolPath(tool())};
+      f.variables = {{"args", fmt::format("fit --name {} --angle {} --channels {}", a->name, angle_, channels_)}};
+      ctx.Build(tool(), f);
+    }
+    diags.ThrowIfAny();
+  }
+
+ private:
+  // Mirrors lut/gt7_mapping.h TimeMapping::ParseName (the generator does not link the lut module).
+  static bool Gt7NameOk(const std::string& s) {
+    const std::string base = s.substr(0, s.find(':'));
+    if (base != "gt7" && base != "gt7-quadratic") return false;
+    if (s.find(':') == std::string::npos) return true;
+    int u = 0, l = 0;
+    char tail = 0;
+    const std::string counts = s.substr(s.find(':') + 1);
+    return std::sscanf(counts.c_str(), "%d+%d%c", &u, &l, &tail) == 2 && u >= 2 && l >= 2 && u + l <= 4096 &&
+           counts == fmt::format("{}+{}", u, l);
+  }
+  static std::string Size(YamlMap& m, std::string_view key, const std::string& fallback) {
+    std::optional<YamlNode> n = m.Get(key);
+    if (!n) return fallback;
+    const std::optional<std::string> text = n->ToString("WxH, e.g. 32x32");
+    int w = 0, h = 0;
+    char tail = 0;
+    if (!text || std::sscanf(text->c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w < 2 || h < 2 || w > 4096 || h > 4096 ||
+        *text != fmt::format("{}x{}", w, h)) {
+      if (text) n->ErrorExpected("WxH with sides from 2 to 4096, e.g. 32x32");
+      return fallback;
+    }
+    return *text;
+  }
+
+  bool enabled_ = false;
+  std::string method_ = "orders";
+  std::string quality_ = "medium";
+  double cut_km_ = 1.0;
+  std::string time_mapping_ = "gt7-quadratic";
+  std::string lut_size_ = "32x32";
+  std::string attenuation_size_ = "64x64";
+  std::vector<double> sun_zenith_deg_ = {30, 60, 80, 88, 92, 96};
+  int elevations_ = 9;
+  std::vector<double> azimuths_deg_ = {0, 30, 90, 150, 180};
+  int depths_ = 16;
+  std::string angle_ = "path";
+  std::string channels_ = "rgb";
+  std::vector<std::pair<std::string, FileLoc>> skies_;
+};
+
+}  // namespace
+
+std::unique_ptr<Stage> MakeFogFitStage() { return std::make_unique<FogFitStage>(); }
+
+}  // namespace skybake
