@@ -1,0 +1,163 @@
+// The `orders` method (transport/method_orders.h, Bruneton & Neyret 2008 successive orders on
+// tables) against the exact single scattering of `single`, against the converged path tracer in
+// the clear and hazed atmospheres from daylight to twilight (measured errors, honest bounds:
+// docs/sky-methods.md "orders"), and for determinism at any thread count.
+#include <gtest/gtest.h>
+
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "method_scenes.h"
+#include "transport/method_orders.h"
+
+using namespace skybake;
+using namespace skybake::testing;
+
+namespace {
+
+std::vector<ColorEstimate> PathY(const TestScene& sc, double sun_zenith_deg, const std::vector<std::array<double, 3>>& dirs,
+                                 double target) {
+  PathTracerSettings ps;
+  ps.target_relative_error = target;
+  ps.min_paths = 1024;
+  PathTracer pt(sc.model, sc.weights, ps);
+  std::vector<ColorEstimate> out(dirs.size());
+  const glm::dvec3 x(0, 0, sc.model.bottom_radius_m + 1.0);
+  tbb::parallel_for(size_t{0}, dirs.size(), [&](size_t d) {
+    out[d] = pt.Radiance(x, glm::dvec3(dirs[d][0], dirs[d][1], dirs[d][2]), DirectionFromAngles(sun_zenith_deg * kDeg, 0), 300 + d);
+  });
+  return out;
+}
+
+std::vector<double> MethodY(const TestScene& sc, const SkyMethod& method, double sun_zenith_deg,
+                            const std::vector<std::array<double, 3>>& dirs) {
+  std::vector<double> L;
+  method.Radiance(1.0, sun_zenith_deg * kDeg, dirs, &L);
+  std::vector<double> y;
+  for (size_t d = 0; d < dirs.size(); ++d) y.push_back(sc.Y(L.data() + d * sc.model.wavelengths()));
+  return y;
+}
+
+// Sky directions away from the aureole: zenith, mid sky, low sky and the horizon band, towards,
+// across and away from the sun (azimuth from the sun), and one below the horizon.
+const std::vector<std::array<double, 3>>& SkyDirs() {
+  static const std::vector<std::array<double, 3>> d = {Dir(0, 0),   Dir(40, 90),  Dir(60, 180), Dir(75, 45),
+                                                       Dir(85, 120), Dir(88, 10),  Dir(88, 90),  Dir(88, 180),
+                                                       Dir(89.5, 60), Dir(95, 150)};
+  return d;
+}
+
+}  // namespace
+
+// With no multiple-scattering orders (max_orders 1) `orders` is its exact single scattering plus
+// the ground's reflection of the direct sun, which `single` computes with a different march
+// (altitude ladder, tabulated sun transmittance): they agree to the quadratures. Measured on the
+// hazed sky: <= 0.6 % at sun 30 deg (both within 1.5 % of the path tracer's first order), up to
+// 2.9 % at sun 80 deg near the horizon, where the two marches resolve the aerosol layer's
+// optical depth differently.
+TEST(MethodOrders, FirstOrderIsTheSingleScattering) {
+  const TestScene sc = LoadTestScene("hazed");
+  SkyMethodOptions o;
+  o.quality = "medium";
+  o.orders = 1;
+  std::unique_ptr<SkyMethod> orders = MakeSkyMethod("orders", sc.model, o, {});
+  std::unique_ptr<SkyMethod> single = MakeSkyMethod("single", sc.model, o, {});
+  for (const auto& [sza, bound] : {std::pair{30.0, 0.01}, std::pair{80.0, 0.035}}) {
+    const std::vector<double> a = MethodY(sc, *orders, sza, SkyDirs()), b = MethodY(sc, *single, sza, SkyDirs());
+    for (size_t d = 0; d < a.size(); ++d) EXPECT_NEAR(a[d] / b[d], 1.0, bound) << "sun " << sza << " dir " << d;
+  }
+}
+
+// All orders against the path tracer (all orders; 1.5 % standard error per direction, 2 % at
+// sun 90 deg), clear (aerosol tau_550 0.1) and hazed (0.5), on the 21-wavelength test grid,
+// medium tables. Measured (RMS / max over the 10 directions, noise included):
+//   clear: sun 30: 1.5 / 2.1 %, 70: 1.7 / 3.4 %, 85: 1.5 / 4.1 %, 90: 2.8 / 4.6 %
+//   hazed: sun 30: 3.5 / 5.6 %, 70: 6.5 / 14.5 %, 85: 6.9 / 11.4 %, 90: 6.0 / 11.0 %
+// The bounds are those figures plus the reference's noise. The target (RMS 0.5 %, max
+// 2 %) is NOT met; the hazed error is already in the second order and depends on the forward-
+// peak truncation (docs/sky-methods.md "orders": measured with truncation 5/8/15/30 deg).
+struct OrdersCase {
+  double sza, target, max_rms, max_abs;
+};
+
+TEST(MethodOrders, AgainstThePathTracerFromDaylightToSunset) {
+  const std::pair<const char*, std::vector<OrdersCase>> sets[] = {
+      {"clear", {{30.0, 0.015, 0.03, 0.05}, {70.0, 0.015, 0.03, 0.06}, {85.0, 0.015, 0.03, 0.07}, {90.0, 0.02, 0.045, 0.08}}},
+      {"hazed", {{30.0, 0.015, 0.05, 0.08}, {70.0, 0.015, 0.09, 0.18}, {85.0, 0.015, 0.09, 0.15}, {90.0, 0.02, 0.09, 0.15}}}};
+  for (const auto& [atm, cases] : sets) {
+    const TestScene sc = LoadTestScene(atm);
+    SkyMethodOptions o;
+    o.quality = "medium";
+    std::unique_ptr<SkyMethod> orders = MakeSkyMethod("orders", sc.model, o, {});
+    for (const OrdersCase& c : cases) {
+      const std::vector<ColorEstimate> ref = PathY(sc, c.sza, SkyDirs(), c.target);
+      const std::vector<double> y = MethodY(sc, *orders, c.sza, SkyDirs());
+      double ss = 0.0, noise = 0.0, worst = 0.0;
+      for (size_t d = 0; d < y.size(); ++d) {
+        const double e = y[d] / ref[d].xyz[1] - 1.0, s = ref[d].xyz_stderr[1] / ref[d].xyz[1];
+        ss += e * e;
+        noise += s * s;
+        worst = std::max(worst, std::abs(e));
+        EXPECT_TRUE(std::isfinite(y[d]) && y[d] > 0.0) << atm << " sun " << c.sza << " dir " << d;
+      }
+      const double rms = std::sqrt(ss / static_cast<double>(y.size()));
+      const double rms_corrected = std::sqrt(std::max(0.0, ss - noise) / static_cast<double>(y.size()));
+      std::printf("orders vs path, %s sun %.0f deg: RMS %.2f %% (noise-corrected %.2f %%), max %.2f %%\n", atm, c.sza,
+                  100.0 * rms, 100.0 * rms_corrected, 100.0 * worst);
+      EXPECT_LT(rms, c.max_rms) << atm << " sun " << c.sza;
+      EXPECT_LT(worst, c.max_abs) << atm << " sun " << c.sza;
+    }
+  }
+}
+
+// The same bytes at 1 and 2 threads (tables built in parallel, reductions in a fixed order).
+TEST(MethodOrders, SameResultAtAnyThreadCount) {
+  const TestScene sc = LoadTestScene("clear");
+  SkyMethodOptions o;
+  o.quality = "low";
+  std::vector<double> a, b;
+  {
+    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+    MakeSkyMethod("orders", sc.model, o, {})->Radiance(1.0, 80.0 * kDeg, SkyDirs(), &a);
+  }
+  {
+    tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);
+    MakeSkyMethod("orders", sc.model, o, {})->Radiance(1.0, 80.0 * kDeg, SkyDirs(), &b);
+  }
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i], b[i]) << i;
+}
+
+// Capping the orders removes light monotonically, and the default stopping rule (orders until
+// the next adds < 0.1 % or the geometric tail is that accurate, then the tail with a ratio per
+// table element) is within 0.5 % of 40 explicit orders at every direction of the hazed sky
+// (measured: 0.3 %; one global ratio: 0.55 %; low's tolerance 3e-3: 2.8 % at the horizon).
+TEST(MethodOrders, OrdersConvergeAndTheTailIsAccurate) {
+  const TestScene sc = LoadTestScene("hazed");
+  std::vector<double> prev;
+  for (int n : {2, 3, 5}) {
+    SkyMethodOptions o;
+    o.quality = "low";
+    o.orders = n;
+    o.table_size["early_tail"] = 0;
+    const std::vector<double> y = MethodY(sc, *MakeSkyMethod("orders", sc.model, o, {}), 60.0, SkyDirs());
+    if (!prev.empty()) {
+      for (size_t d = 0; d < y.size(); ++d) EXPECT_GE(y[d], prev[d] * (1.0 - 1e-6)) << n << " orders, dir " << d;
+    }
+    prev = y;
+  }
+  SkyMethodOptions all;
+  all.quality = "low";
+  all.orders = 40;
+  all.order_tolerance = 1e-7;
+  all.table_size["early_tail"] = 0;
+  SkyMethodOptions dflt;
+  dflt.quality = "low";
+  dflt.order_tolerance = 1e-3;  // medium's and high's stopping rule on low's tables
+  const std::vector<double> y_all = MethodY(sc, *MakeSkyMethod("orders", sc.model, all, {}), 60.0, SkyDirs());
+  const std::vector<double> y_def = MethodY(sc, *MakeSkyMethod("orders", sc.model, dflt, {}), 60.0, SkyDirs());
+  for (size_t d = 0; d < y_all.size(); ++d) EXPECT_NEAR(y_def[d] / y_all[d], 1.0, 0.005) << "dir " << d;
+}
