@@ -1,0 +1,92 @@
+#!/usr/bin/env python3
+"""Speed of the fast deterministic sky (`orders`) on the GT7 LUT set (issue 5's speed target:
+the 8 basis skies x 64 sun slices x their texels at >= 40 wavelengths in <= 60 s on 2 cores;
+docs/sky-methods.md "orders"). Prints a table; writes only into its work folder.
+
+  bench/sky_lut_bench.py [--bin build/release/bin] [--outputs outputs] [--pipeline pipeline.yaml]
+                         [--skies clear,hazed,...] [--threads 1,2] [--work /tmp/sky_lut_bench]
+                         [--wavelengths 360:830:5]
+
+Needs a baked outputs/ (profiles and Mie tables, from `scripts/bake`). For every basis sky of the
+pipeline's `luts` section, the exact LUT render the pipeline runs (sky-render render --method
+orders --mapping gt7 --time-mapping ... --size ...) is timed at each thread count, and once with
+a 2x2 mapping, which is the table build alone (the solve of the orders; the render of 2x2x64
+directions is negligible). The set's total at 2 threads is compared with the 60 s target, and
+the scaling 1 -> 2 threads is printed (target >= 1.8x).
+"""
+import argparse
+import os
+import re
+import subprocess
+import sys
+import time
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
+
+
+def luts_section(pipeline):
+    """(method, quality, time_mapping, [(sky, size)]) read from pipeline.yaml's luts section."""
+    text = open(pipeline).read()
+    sec = text[text.index("\nluts:"):]
+    sec = sec[:re.search(r"\n\S", sec[1:]).start() + 1]
+    get = lambda k, d: (re.search(r"\n  %s: *([^\s#]+)" % k, sec) or [None, d])[1]
+    skies = re.findall(r"\{atmosphere: *(\w+), *size: *(\d+x\d+)\}", sec)
+    return get("method", "orders"), get("quality", "medium"), get("time_mapping", "gt7-quadratic"), skies
+
+
+def timed(args, cwd):
+    t0 = time.perf_counter()
+    r = subprocess.run(args, cwd=cwd, capture_output=True, text=True)
+    dt = time.perf_counter() - t0
+    if r.returncode != 0:
+        sys.exit("failed: %s\n%s" % (" ".join(args), r.stderr))
+    return dt
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--bin", default=os.path.join(ROOT, "build", "release", "bin"))
+    ap.add_argument("--outputs", default=os.path.join(ROOT, "outputs"))
+    ap.add_argument("--pipeline", default=os.path.join(ROOT, "pipeline.yaml"))
+    ap.add_argument("--skies", default="")
+    ap.add_argument("--threads", default="1,2")
+    ap.add_argument("--work", default="/tmp/sky_lut_bench")
+    ap.add_argument("--wavelengths", default="360:830:5")
+    a = ap.parse_args()
+    method, quality, time_mapping, skies = luts_section(a.pipeline)
+    if a.skies:
+        keep = a.skies.split(",")
+        skies = [s for s in skies if s[0] in keep]
+    threads = [int(t) for t in a.threads.split(",")]
+    os.makedirs(a.work, exist_ok=True)
+    out = os.path.abspath(a.outputs)
+    nwl = len(range(*[int(float(x)) for x in a.wavelengths.split(":")])) + 1
+    print("sky-render --method %s --quality %s --time-mapping %s, %d wavelengths (%s nm), %d cpus"
+          % (method, quality, time_mapping, nwl, a.wavelengths, os.cpu_count()))
+    print("%-8s %-7s %8s %12s %s" % ("sky", "size", "build_s", "render_s", "(wall s at threads " + a.threads + ")"))
+    totals = {t: 0.0 for t in threads}
+    for sky, size in skies:
+        base = [os.path.join(os.path.abspath(a.bin), "sky-render"), "--quiet", "render", "--method", method,
+                "--quality", quality, "--profiles", "%s/profiles.exr" % sky, "--mie-dir", "mie",
+                "--wavelengths", a.wavelengths, "--mapping", "gt7", "--time-mapping", time_mapping]
+        comp = "%s/components/render.yaml" % sky
+        build = timed(base + ["--size", "2x2", "--threads", str(max(threads)), "-o",
+                              os.path.join(a.work, sky + "_build.exr"), comp], out)
+        walls = []
+        for t in threads:
+            w = timed(base + ["--size", size, "--threads", str(t), "-o", os.path.join(a.work, "%s_t%d.exr" % (sky, t)), comp], out)
+            totals[t] += w
+            walls.append(w)
+        same = len({open(os.path.join(a.work, "%s_t%d.exr" % (sky, t)), "rb").read() for t in threads}) == 1
+        print("%-8s %-7s %8.1f %12s %s" % (sky, size, build, " ".join("%.1f" % w for w in walls),
+                                           "same bytes" if same else "BYTES DIFFER between thread counts"))
+    for t in threads:
+        print("set total at %d thread%s: %.1f s" % (t, "s" if t > 1 else "", totals[t]))
+    if 1 in totals and 2 in totals and totals[2] > 0:
+        print("scaling 1 -> 2 threads: %.2fx (target >= 1.8x)" % (totals[1] / totals[2]))
+    if 2 in totals:
+        print("target: the set in <= 60 s on 2 cores: %s" % ("met" if totals[2] <= 60 else "NOT met"))
+
+
+if __name__ == "__main__":
+    main()
