@@ -38,6 +38,7 @@ struct SceneOptions {
   double aerosol_tau_550 = -1.0;  // < 0: the file's
   AerosolPhase phase = AerosolPhase::kTabulated;
   bool aerosols = true;
+  double step_nm = 20.0;  // wavelength grid step from 380 to 780 nm
 };
 
 // atmospheres/<name>.yaml with its particle type, 100 m levels, 380-780 nm at 20 nm (21 samples).
@@ -48,7 +49,7 @@ inline TestScene LoadTestScene(const std::string& name, const SceneOptions& o = 
     for (AerosolLayerSpec& a : spec.aerosols) a.scale->value = o.aerosol_tau_550;
   }
   VerticalProfiles prof = ComputeProfiles(spec);
-  const WavelengthGrid grid = WavelengthGrid::Uniform(380, 780, 20);
+  const WavelengthGrid grid = WavelengthGrid::Uniform(380, 780, o.step_nm);
   std::vector<AerosolOptics> aerosols;
   if (o.aerosols) {
     for (const AerosolLayerSpec& layer : spec.aerosols) {

@@ -80,6 +80,10 @@ int main(int argc, char** argv) {
   render->add_option("--method", ro.method, "Rendering method: path (the Monte-Carlo reference), single, orders, ms-approx, analytic")
       ->default_val("path");
   render->add_option("--quality", ro.method_options.quality, "Deterministic methods: low, medium or high")->default_val("medium");
+  render->add_option("--spectral-stride", ro.method_options.spectral_stride,
+                     "Deterministic methods: run on every k-th wavelength (and the last), the transfer "
+                     "interpolated to the grid (docs/sky-methods.md)")
+      ->default_val(1);
   render->add_option("--mapping", ro.mapping, "Direction mapping: equirectangular, fisheye or gt7 (lut-pack's, docs/lut-pack.md)")->default_val("equirectangular");
   render->add_option("--size", ro.size, "Image size WxH")->default_val("64x32");
   CLI::Option* sza = render->add_option("--sun-zenith-deg", ro.sun_zenith_deg, "Sun zenith angles (deg), comma separated")

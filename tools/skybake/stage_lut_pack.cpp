@@ -8,6 +8,7 @@
 //   luts:
 //     method: orders               # sky-render method of the LUT renders (docs/sky-methods.md)
 //     quality: medium              # its quality preset
+//     spectral_stride: 4           # the method on every 4th wavelength, transfer interpolated (1 = all)
 //     time_mapping: gt7-quadratic  # or gt7 (the talk's; docs/lut-pack.md), optionally ":<upper>+<lower>"
 //     sky_exposure_stops: auto     # or N: sky texels store cd/m^2 x 2^N (auto: per texture, no clamping)
 //     budget_mib: 3.5              # lut-pack fails when the sky LUTs exceed it
@@ -17,6 +18,7 @@
 // Each render edge depends on its atmosphere's render component (written by the sky-render
 // stage), profiles and Mie tables, so an edit to one atmosphere re-renders only its LUT and re-runs
 // the pack edge, whose unchanged textures keep their bytes and times (write-if-changed + restat).
+#include <cmath>
 #include <fmt/format.h>
 
 #include <set>
@@ -45,6 +47,12 @@ class LutPackStage : public Stage {
     enabled_ = true;
     method_ = luts->ChoiceOr("method", {"orders", "single", "ms-approx", "analytic"}, method_);
     quality_ = luts->ChoiceOr("quality", {"low", "medium", "high"}, quality_);
+    const double stride = luts->NumberOr("spectral_stride", NumberSpec::Range(1, 64, "wavelengths"), spectral_stride_);
+    if (stride != std::floor(stride)) {
+      luts->Get("spectral_stride")->ErrorExpected("a whole number of wavelengths from 1 to 64");
+    } else {
+      spectral_stride_ = static_cast<int>(stride);
+    }
     if (std::optional<YamlNode> tm = luts->Get("time_mapping")) {
       if (std::optional<std::string> s = tm->ToString()) {
         if (!gt7_names_ok(*s)) {
@@ -128,11 +136,13 @@ class LutPackStage : public Stage {
         if (layer.particle) particles.insert(layer.particle->stem().string());
       }
       for (const std::string& p : particles) b.implicit_inputs.push_back(paths::MieTable(p).generic_string());
-      b.variables = {{"args", fmt::format("render --method {} --quality {} --profiles {} --mie-dir mie --wavelengths {}:{}:{} "
-                                          "--mapping gt7 --size {} --time-mapping {}",
-                                          method_, quality_, paths::Profiles(a->name).generic_string(),
-                                          FormatExact(wl.min_nm), FormatExact(wl.max_nm), FormatExact(wl.step_nm), s.size,
-                                          time_mapping_)}};
+      std::string args = fmt::format("render --method {} --quality {} --profiles {} --mie-dir mie --wavelengths {}:{}:{} "
+                                     "--mapping gt7 --size {} --time-mapping {}",
+                                     method_, quality_, paths::Profiles(a->name).generic_string(),
+                                     FormatExact(wl.min_nm), FormatExact(wl.max_nm), FormatExact(wl.step_nm), s.size,
+                                     time_mapping_);
+      if (spectral_stride_ > 1) args += fmt::format(" --spectral-stride {}", spectral_stride_);
+      b.variables = {{"args", args}};
       ctx.Build("sky-render", b);
       packed.emplace_back(a->name, b.outputs[0]);
     }
@@ -171,6 +181,7 @@ class LutPackStage : public Stage {
   bool enabled_ = false;
   std::string method_ = "orders";
   std::string quality_ = "medium";
+  int spectral_stride_ = 1;
   std::string time_mapping_ = "gt7-quadratic";
   std::string exposure_stops_ = "auto";
   double budget_mib_ = 3.5;

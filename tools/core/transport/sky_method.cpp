@@ -1,5 +1,7 @@
 #include "transport/sky_method.h"
 
+#include <algorithm>
+
 #include <glm/geometric.hpp>
 
 #include <fmt/format.h>
@@ -9,6 +11,7 @@
 #include "transport/method_analytic.h"
 #include "transport/method_ms_approx.h"
 #include "transport/method_single.h"
+#include "transport/spectral_stride.h"
 
 namespace skybake {
 
@@ -21,6 +24,14 @@ std::vector<std::string> SkyMethodNames() { return {"single", "orders", "ms-appr
 
 std::unique_ptr<SkyMethod> MakeSkyMethod(const std::string& name, const AtmosphereModel& model,
                                          const SkyMethodOptions& options, const ProgressFn& progress) {
+  if (options.spectral_stride < 1 || options.spectral_stride > 64) {
+    throw UsageError(fmt::format("--spectral-stride: expected 1 to 64, got {}", options.spectral_stride));
+  }
+  if (options.spectral_stride > 1 && model.wavelengths() > 2) {
+    const std::vector<std::string> names = SkyMethodNames();
+    const bool known = std::find(names.begin(), names.end(), name) != names.end();
+    if (known) return MakeSpectralStrideMethod(name, model, options, progress);
+  }
   if (name == "single") return MakeSingleMethod(model, options);
   if (name == "ms-approx") return MakeMsApproxMethod(model, options, progress);
   if (name == "analytic") return MakeAnalyticMethod(model, options);

@@ -31,6 +31,9 @@ struct SkyMethodOptions {
   // Observer altitude the tables are built for (orders puts a radius node there; other
   // altitudes are interpolated between nodes).
   double observer_altitude_m = 0.0;
+  // > 1: the method runs on every k-th wavelength of the grid (and the last) and the transfer is
+  // interpolated to the grid (transport/spectral_stride.h); 1: every wavelength.
+  int spectral_stride = 1;
 };
 
 class SkyMethod {
