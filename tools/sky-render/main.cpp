@@ -128,6 +128,9 @@ int main(int argc, char** argv) {
   fog->add_option("--method", fo.method, "orders (deterministic, all orders) or path (the Monte-Carlo reference)")
       ->default_val("orders");
   fog->add_option("--quality", fo.method_options.quality, "orders: low, medium or high")->default_val("medium");
+  fog->add_option("--spectral-stride", fo.method_options.spectral_stride,
+                  "orders: run on every k-th wavelength (and the last), the transfer interpolated (docs/sky-methods.md)")
+      ->default_val(1);
   fog->add_option("--cut-altitude-km", cut_km, "Top of the low atmosphere that scatters into the fog (km; docs/fog.md)")
       ->default_val(1.0);
   fog->add_option("--observer-altitude-m", fo.observer_altitude_m, "Override the atmosphere's observer altitude (m)");

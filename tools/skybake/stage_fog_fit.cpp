@@ -9,7 +9,8 @@
 // Only with a `fog` section in pipeline.yaml:
 //   fog:
 //     method: orders               # sky-render fog method (orders or path)
-//     quality: medium              # orders quality preset
+//     quality: low                 # orders quality preset (docs/fog.md, "Bake time")
+//     spectral_stride: 4           # orders on every k-th wavelength (docs/sky-methods.md)
 //     cut_altitude_km: 1           # top of the low atmosphere (docs/fog.md, "The cut")
 //     time_mapping: gt7-quadratic  # GT7 time mapping of the fog LUT slices (as luts.time_mapping)
 //     lut_size: 32x32              # fog LUT slice W x H (GT7: 32 x 32 x 64)
@@ -42,6 +43,7 @@ class FogFitStage : public Stage {
     enabled_ = true;
     method_ = fog->ChoiceOr("method", {"orders", "path"}, method_);
     quality_ = fog->ChoiceOr("quality", {"low", "medium", "high"}, quality_);
+    stride_ = static_cast<int>(fog->IntegerOr("spectral_stride", 1, 64, "a whole number from 1 to 64", stride_));
     cut_km_ = fog->NumberOr("cut_altitude_km", NumberSpec::Range(0.001, 100.0, "km"), cut_km_);
     if (std::optional<YamlNode> tm = fog->Get("time_mapping")) {
       if (std::optional<std::string> s = tm->ToString()) {
@@ -113,10 +115,10 @@ class FogFitStage : public Stage {
         if (layer.particle) particles.insert(layer.particle->stem().string());
       }
       for (const std::string& p : particles) r.implicit_inputs.push_back(paths::MieTable(p).generic_string());
-      r.variables = {{"args", fmt::format("fog --method {} --quality {} --profiles {} --mie-dir mie --wavelengths {}:{}:{} "
+      r.variables = {{"args", fmt::format("fog --method {} --quality {} --spectral-stride {} --profiles {} --mie-dir mie --wavelengths {}:{}:{} "
                                           "--cut-altitude-km {} --lut-size {} --time-mapping {} --attenuation-size {} "
                                           "--sun-zenith-deg {} --elevations {} --azimuths-deg {} --depths {}",
-                                          method_, quality_, paths::Profiles(a->name).generic_string(),
+                                          method_, quality_, stride_, paths::Profiles(a->name).generic_string(),
                                           FormatExact(wl.min_nm), FormatExact(wl.max_nm), FormatExact(wl.step_nm),
                                           FormatExact(cut_km_), lut_size_, time_mapping_, attenuation_size_,
                                           join(sun_zenith_deg_), elevations_, join(azimuths_deg_), depths_)}};
@@ -162,7 +164,8 @@ class FogFitStage : public Stage {
 
   bool enabled_ = false;
   std::string method_ = "orders";
-  std::string quality_ = "medium";
+  std::string quality_ = "low";
+  int stride_ = 1;
   double cut_km_ = 1.0;
   std::string time_mapping_ = "gt7-quadratic";
   std::string lut_size_ = "32x32";
