@@ -13,7 +13,7 @@ cut altitude, and the LUT sizes. Prints tables; writes nothing outside its work 
    (depth <= 1 km), at the horizon (elevation <= 1 deg) and at infinite depth (the LUT alone).
 2. The same render fitted with --channels luminance (one a, p for R, G, B) and with --angle
    elevation (the talk's theta): RMS near the camera and at the horizon.
-3. The cut: for the first sky, depth tables only (a 2x2 LUT) at each --cuts-km, fit error.
+3. The cut: for each of --cut-skies, depth tables only (a 2x2 LUT) at each --cuts-km, fit error.
 4. Bytes of every texture of the first sky.
 """
 import argparse
@@ -56,7 +56,8 @@ def main():
     ap.add_argument("--mie-dir", default=os.path.join(ROOT, "outputs", "mie"))
     ap.add_argument("--renders", default=os.path.join(ROOT, "outputs"))
     ap.add_argument("--skies", default="clear,hazed")
-    ap.add_argument("--cuts-km", default="1,2,3.5")
+    ap.add_argument("--cuts-km", default="0.25,0.5,1,2,3.5")
+    ap.add_argument("--cut-skies", default="clear,hazed,cloudy2")
     ap.add_argument("--work", default="/tmp/fog_bench")
     a = ap.parse_args()
     skies = a.skies.split(",")
@@ -106,16 +107,17 @@ def main():
             cols.append("%s / %s / %s" % (pct(f["near_camera"]["rms"]), pct(f["horizon"]["rms"]), pct(f["all"]["rms"])))
         print("%-8s %-22s %-22s %-22s" % (sky, cols[0], cols[1], cols[2]))
 
+    print("\n3. The cut (depth tables only, 2x2 LUT): fit error RMS % near camera / horizon / all, render time")
+    for sky in a.cut_skies.split(","):
+        for cut in a.cuts_km.split(","):
+            render = os.path.join(a.work, "%s_cut%s.exr" % (sky, cut))
+            seconds = run([os.path.join(a.bin, "sky-render"), "--quiet", "fog", os.path.join(ROOT, "atmospheres", sky + ".yaml"),
+                           "--mie-dir", a.mie_dir, "--cut-altitude-km", cut, "--lut-size", "2x2",
+                           "--time-mapping", "gt7:2+2", "-o", render] + TABLES)
+            f = fit(a.bin, render, os.path.join(a.work, "cut" + cut), sky)[1]["errors"]["fog"]["fit"]
+            print("  %-8s cut %4s km: %s / %s / %s   (%.1f s)" % (sky, cut, pct(f["near_camera"]["rms"]), pct(f["horizon"]["rms"]),
+                                                                pct(f["all"]["rms"]), seconds))
     sky = skies[0]
-    print("\n3. The cut (%s; depth tables only, 2x2 LUT): fit error RMS %% near camera / horizon / all, render time" % sky)
-    for cut in a.cuts_km.split(","):
-        render = os.path.join(a.work, "%s_cut%s.exr" % (sky, cut))
-        seconds = run([os.path.join(a.bin, "sky-render"), "--quiet", "fog", os.path.join(ROOT, "atmospheres", sky + ".yaml"),
-                       "--mie-dir", a.mie_dir, "--cut-altitude-km", cut, "--lut-size", "2x2",
-                       "--time-mapping", "gt7:2+2", "-o", render] + TABLES)
-        f = fit(a.bin, render, os.path.join(a.work, "cut" + cut), sky)[1]["errors"]["fog"]["fit"]
-        print("  cut %4s km: %s / %s / %s   (%.1f s)" % (cut, pct(f["near_camera"]["rms"]), pct(f["horizon"]["rms"]),
-                                                      pct(f["all"]["rms"]), seconds))
 
     print("\n4. Bytes (%s)" % sky)
     d = os.path.join(a.work, "rgb_path")
