@@ -5,7 +5,7 @@ docs/sky-methods.md "orders"). Prints a table; writes only into its work folder.
 
   bench/sky_lut_bench.py [--bin build/release/bin] [--outputs outputs] [--pipeline pipeline.yaml]
                          [--skies clear,hazed,...] [--threads 1,2] [--work /tmp/sky_lut_bench]
-                         [--wavelengths 360:830:5]
+                         [--wavelengths 360:830:5] [--spectral-stride K]
 
 Needs a baked outputs/ (profiles and Mie tables, from `scripts/bake`). For every basis sky of the
 pipeline's `luts` section, the exact LUT render the pipeline runs (sky-render render --method
@@ -25,13 +25,14 @@ ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 
 
 def luts_section(pipeline):
-    """(method, quality, time_mapping, [(sky, size)]) read from pipeline.yaml's luts section."""
+    """(method, quality, time_mapping, spectral_stride, [(sky, size)]) from pipeline.yaml's luts section."""
     text = open(pipeline).read()
     sec = text[text.index("\nluts:"):]
     sec = sec[:re.search(r"\n\S", sec[1:]).start() + 1]
     get = lambda k, d: (re.search(r"\n  %s: *([^\s#]+)" % k, sec) or [None, d])[1]
     skies = re.findall(r"\{atmosphere: *(\w+), *size: *(\d+x\d+)\}", sec)
-    return get("method", "orders"), get("quality", "medium"), get("time_mapping", "gt7-quadratic"), skies
+    return (get("method", "orders"), get("quality", "medium"), get("time_mapping", "gt7-quadratic"),
+            get("spectral_stride", "1"), skies)
 
 
 def timed(args, cwd):
@@ -52,8 +53,11 @@ def main():
     ap.add_argument("--threads", default="1,2")
     ap.add_argument("--work", default="/tmp/sky_lut_bench")
     ap.add_argument("--wavelengths", default="360:830:5")
+    ap.add_argument("--spectral-stride", default="", help="override luts.spectral_stride")
     a = ap.parse_args()
-    method, quality, time_mapping, skies = luts_section(a.pipeline)
+    method, quality, time_mapping, stride, skies = luts_section(a.pipeline)
+    if a.spectral_stride:
+        stride = a.spectral_stride
     if a.skies:
         keep = a.skies.split(",")
         skies = [s for s in skies if s[0] in keep]
@@ -61,14 +65,15 @@ def main():
     os.makedirs(a.work, exist_ok=True)
     out = os.path.abspath(a.outputs)
     nwl = len(range(*[int(float(x)) for x in a.wavelengths.split(":")])) + 1
-    print("sky-render --method %s --quality %s --time-mapping %s, %d wavelengths (%s nm), %d cpus"
-          % (method, quality, time_mapping, nwl, a.wavelengths, os.cpu_count()))
+    print("sky-render --method %s --quality %s --time-mapping %s --spectral-stride %s, %d wavelengths (%s nm), %d cpus"
+          % (method, quality, time_mapping, stride, nwl, a.wavelengths, os.cpu_count()))
     print("%-8s %-7s %8s %12s %s" % ("sky", "size", "build_s", "render_s", "(wall s at threads " + a.threads + ")"))
     totals = {t: 0.0 for t in threads}
     for sky, size in skies:
         base = [os.path.join(os.path.abspath(a.bin), "sky-render"), "--quiet", "render", "--method", method,
                 "--quality", quality, "--profiles", "%s/profiles.exr" % sky, "--mie-dir", "mie",
-                "--wavelengths", a.wavelengths, "--mapping", "gt7", "--time-mapping", time_mapping]
+                "--wavelengths", a.wavelengths, "--mapping", "gt7", "--time-mapping", time_mapping,
+                "--spectral-stride", stride]
         comp = "%s/components/render.yaml" % sky
         build = timed(base + ["--size", "2x2", "--threads", str(max(threads)), "-o",
                               os.path.join(a.work, sky + "_build.exr"), comp], out)
