@@ -74,8 +74,10 @@ TEST(MethodOrders, FirstOrderIsTheSingleScattering) {
 // All orders against the path tracer (all orders; 1.5 % standard error per direction, 2 % at
 // sun 90 deg), clear (aerosol tau_550 0.1) and hazed (0.5), on the 21-wavelength test grid,
 // medium tables. Measured (RMS / max over the 10 directions, noise included):
-//   clear: sun 30: 1.5 / 2.1 %, 70: 1.7 / 3.4 %, 85: 1.5 / 4.1 %, 90: 2.8 / 4.6 %
-//   hazed: sun 30: 3.5 / 5.6 %, 70: 6.5 / 14.5 %, 85: 6.9 / 11.4 %, 90: 6.0 / 11.0 %
+//   clear: sun 30: 1.3 / 2.4 %, 70: 1.9 / 3.7 %, 85: 1.9 / 3.8 %, 90: 2.6 / 4.3 %
+//   hazed: sun 30: 5.9 / 8.3 %, 70: 6.3 / 14.1 %, 85: 3.3 / 7.3 %, 90: 2.9 / 4.9 %
+// (radius nodes following the optical depth; with altitude-only nodes the hazed rows were
+// 4.1 / 7.1, 6.6 / 14.4, 6.4 / 11.0, 5.7 / 9.3 %.)
 // The bounds are those figures plus the reference's noise. The issue's target (RMS 0.5 %, max
 // 2 %) is NOT met; the hazed error is already in the second order and depends on the forward-
 // peak truncation (docs/sky-methods.md "orders": measured with truncation 5/8/15/30 deg).
@@ -86,7 +88,7 @@ struct OrdersCase {
 TEST(MethodOrders, AgainstThePathTracerFromDaylightToSunset) {
   const std::pair<const char*, std::vector<OrdersCase>> sets[] = {
       {"clear", {{30.0, 0.015, 0.03, 0.05}, {70.0, 0.015, 0.03, 0.06}, {85.0, 0.015, 0.03, 0.07}, {90.0, 0.02, 0.045, 0.08}}},
-      {"hazed", {{30.0, 0.015, 0.05, 0.08}, {70.0, 0.015, 0.09, 0.18}, {85.0, 0.015, 0.09, 0.15}, {90.0, 0.02, 0.09, 0.15}}}};
+      {"hazed", {{30.0, 0.015, 0.075, 0.11}, {70.0, 0.015, 0.09, 0.18}, {85.0, 0.015, 0.06, 0.11}, {90.0, 0.02, 0.06, 0.09}}}};
   for (const auto& [atm, cases] : sets) {
     const TestScene sc = LoadTestScene(atm);
     SkyMethodOptions o;
@@ -160,4 +162,62 @@ TEST(MethodOrders, OrdersConvergeAndTheTailIsAccurate) {
   const std::vector<double> y_all = MethodY(sc, *MakeSkyMethod("orders", sc.model, all, {}), 60.0, SkyDirs());
   const std::vector<double> y_def = MethodY(sc, *MakeSkyMethod("orders", sc.model, dflt, {}), 60.0, SkyDirs());
   for (size_t d = 0; d < y_all.size(); ++d) EXPECT_NEAR(y_def[d] / y_all[d], 1.0, 0.005) << "dir " << d;
+}
+
+// A thin, optically thick, conservative layer - a 2 km water-cloud-like tent of optical depth 8
+// at 3.5-5.5 km, Henyey-Greenstein g = 0.8, over a ground of albedo 0.3 - where the successive
+// orders converge slowly (ratio ~0.7 per order) and the sources change fast with altitude. Before
+// the radius nodes followed the optical depth and the sources were stored per unit scattering
+// coefficient, the orders diverged here (ratio 1.29 per order; the cloudy4 sky at 4e6 cd/m^2).
+// They converge now, but to too little light: measured -34, -47, -53, -40 % against the path
+// tracer (2 %) at the four directions (isotropic scattering: -77 to -81 %; 120 ray steps halve
+// it). This is a known defect of `orders` in thick layers (docs/sky-methods.md "orders", "Thick
+// cloud layers"); the bound guards the convergence and the measured error, not the goal.
+TEST(MethodOrders, ThickCloudLayerConvergesWithinItsMeasuredError) {
+  const double R = 6371e3;
+  AtmosphereModel m;
+  m.bottom_radius_m = R;
+  m.top_radius_m = R + 20e3;
+  m.altitude_m = {0.0, 3500.0, 4500.0, 5500.0, 20e3};
+  m.wavelength_nm = {500.0, 600.0};
+  MediumComponent c;
+  c.name = "aerosol.cloud";
+  c.phase = std::make_shared<HenyeyGreensteinPhase>(std::vector<double>{0.8, 0.8});
+  for (double sigma : {0.0, 0.0, 8e-3, 0.0, 0.0}) {  // m^-1: the tent's area is 8e-3 x 1000 m = 8
+    for (int w = 0; w < 2; ++w) {
+      c.scattering.push_back(sigma);
+      c.absorption.push_back(0.0);
+    }
+  }
+  m.components.push_back(c);
+  m.ground_albedo = {0.3, 0.3};
+  m.sun.irradiance = {1.0, 1.0};
+  m.Finalize();
+  const std::vector<std::array<double, 3>> weights = {{0.0, 0.5, 0.0}, {0.0, 0.5, 0.0}};
+  const std::vector<std::array<double, 3>> dirs = {Dir(0, 0), Dir(60, 0), Dir(60, 180), Dir(85, 90)};
+  SkyMethodOptions o;
+  o.quality = "medium";
+  std::unique_ptr<SkyMethod> orders = MakeSkyMethod("orders", m, o, {});
+  const std::string desc = orders->Describe();
+  std::printf("%s", desc.c_str());
+  EXPECT_EQ(desc.find("orders_computed: 40"), std::string::npos) << "did not converge";
+  std::vector<double> L;
+  orders->Radiance(1.0, 30.0 * kDeg, dirs, &L);
+  PathTracerSettings ps;
+  ps.target_relative_error = 0.02;
+  ps.min_paths = 1024;
+  PathTracer pt(m, weights, ps);
+  std::vector<ColorEstimate> ref(dirs.size());
+  tbb::parallel_for(size_t{0}, dirs.size(), [&](size_t d) {
+    ref[d] = pt.Radiance(glm::dvec3(0, 0, R + 1.0), glm::dvec3(dirs[d][0], dirs[d][1], dirs[d][2]),
+                         DirectionFromAngles(30.0 * kDeg, 0), 500 + d);
+  });
+  for (size_t d = 0; d < dirs.size(); ++d) {
+    const double y = 0.5 * (L[d * 2] + L[d * 2 + 1]);
+    const double e = y / ref[d].xyz[1] - 1.0;
+    std::printf("thick layer, dir %zu: orders %.5g path %.5g +- %.1f %%: %+.1f %%\n", d, y, ref[d].xyz[1],
+                100.0 * ref[d].xyz_stderr[1] / ref[d].xyz[1], 100.0 * e);
+    EXPECT_TRUE(std::isfinite(y) && y > 0.0);
+    EXPECT_LT(std::abs(e), 0.6) << "dir " << d;  // measured 0.34-0.53
+  }
 }

@@ -411,8 +411,26 @@ void OrdersMethod::SunTransmittance(double r, double mu_s, bool scaled, float* o
 
 void OrdersMethod::BuildRadiusNodes() {
   const double R = m_.bottom_radius_m, H = m_.top_radius_m - R;
-  // Altitude h_i = H (i/(n-1))^2.5: 0, 0.12, 0.65, 1.8, 3.7, 6.4, 10 ... 100 km for n = 16.
-  for (int i = 0; i < s_.nr; ++i) radius_.push_back(R + H * std::pow(static_cast<double>(i) / (s_.nr - 1), 2.5));
+  // Nodes uniform in s(h) = (tau(0,h)/tau(0,H) + (h/H)^0.4) / 2, tau the vertical optical depth
+  // at the grid's middle wavelength: the altitude part alone is h_i = H (i/(n-1))^2.5 (0, 0.12,
+  // 0.65, 1.8, 3.7, 6.4, 10 ... 100 km for n = 16), the optical-depth part puts half the nodes
+  // where the extinction is. Without it a 2 km thick water cloud at 3.5-5.5 km (cloudy4) fell
+  // between the nodes 3.7 and 6.4 km, its sources were interpolated from outside the cloud, and
+  // the sky under it came out 3-5x too dark.
+  const size_t wref = m_.wavelengths() / 2;
+  const double tau_total = std::max(m_.VerticalOpticalDepth(0.0, H, wref), 1e-12);
+  auto s_of = [&](double h) { return 0.5 * (m_.VerticalOpticalDepth(0.0, h, wref) / tau_total + std::pow(h / H, 0.4)); };
+  for (int i = 0; i < s_.nr; ++i) {
+    const double u = static_cast<double>(i) / (s_.nr - 1);
+    double lo = 0.0, hi = H;
+    if (i == 0) hi = 0.0;
+    if (i == s_.nr - 1) lo = H;
+    for (int it = 0; it < 60 && hi - lo > 1e-3; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (s_of(mid) < u ? lo : hi) = mid;
+    }
+    radius_.push_back(R + 0.5 * (lo + hi));
+  }
   const double r_obs = R + std::clamp(observer_altitude_m_, 0.0, H * 0.999);
   auto it = std::lower_bound(radius_.begin(), radius_.end(), r_obs);
   if (it != radius_.end() && std::abs(*it - r_obs) < 1e-6) {
@@ -522,13 +540,14 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
   struct Family {
     std::vector<double> t, dt, r, mu;
     std::vector<float> trans;  // [step * nw + w]
+    std::vector<float> ssc;    // [step * nw + w] scaled scattering coefficient sigma_s* at the step (m^-1)
     bool ground = false;
     double d = 0.0;
     std::vector<float> trans_end;  // at the ground
   };
   std::vector<Family> fam(nr * nu_);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nr * nu_, 1), [&](const tbb::blocked_range<size_t>& rg) {
-    std::vector<float> st(nw_);
+    std::vector<float> st(nw_), sc(nw_);
     for (size_t idx = rg.begin(); idx != rg.end(); ++idx) {
       const size_t ri = idx / nu_, k = idx % nu_;
       const double r = radius_[ri], mu = ViewMu(k, r);
@@ -564,6 +583,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
         return (static_cast<double>(l.i) + l.t) * f.d / nf;
       };
       f.trans.resize(nt * nw_);
+      f.ssc.assign(nt * nw_, 0.0f);
       for (size_t m = 0; m < nt; ++m) {
         const double t0 = t_of_s(static_cast<double>(m) / nt), t1 = t_of_s(static_cast<double>(m + 1) / nt);
         const double tm = 0.5 * (t0 + t1);
@@ -572,6 +592,10 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
         const double rr = std::sqrt(r * r + 2.0 * r * mu * tm + tm * tm);
         f.r.push_back(rr);
         f.mu.push_back((r * mu + tm) / rr);
+        for (size_t c = 0; c < nc_; ++c) {
+          SigmaS(c, rr - R, true, sc.data());
+          for (size_t w = 0; w < nw_; ++w) f.ssc[m * nw_ + w] += sc[w];
+        }
         const double pf = tm / f.d * nf;
         const size_t pi = std::min(static_cast<size_t>(pf), static_cast<size_t>(nf) - 1);
         const float pt = static_cast<float>(pf - static_cast<double>(pi));
@@ -746,6 +770,11 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
               const float* lv = &L[(((ri * ns_ + si) * nd) + j) * nw_];
               for (size_t w = 0; w < nw_; ++w) jo[w] += kv[w] * lv[w];
             }
+            // Stored per unit scattering coefficient (J / sigma_s*: the phase-weighted mean
+            // radiance), multiplied back by sigma_s* where it is used. Interpolating J itself
+            // between radius nodes smears a thin dense layer's source over the whole interval:
+            // a 1 km water cloud of optical depth 8 then amplified each order by 1.29.
+            for (size_t w = 0; w < nw_; ++w) jo[w] = ssc_total[w] > 0.0 ? static_cast<float>(jo[w] / ssc_total[w]) : 0.0f;
           }
         }
       }
@@ -770,7 +799,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
             const double cphi = (nu - mu2 * mus) / denom;
             std::fill(jv.begin(), jv.end(), 0.0f);
             Interpolate(J, f.r[m], std::acos(mus), mu2, cphi, f.dt[m], jv.data());
-            for (size_t w = 0; w < nw_; ++w) acc[w] += f.trans[m * nw_ + w] * jv[w];
+            for (size_t w = 0; w < nw_; ++w) acc[w] += f.trans[m * nw_ + w] * f.ssc[m * nw_ + w] * jv[w];
           }
           if (f.ground) {
             const double mus_g = (r * std::cos(ts) + f.d * nu) / R;
@@ -844,7 +873,7 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
   const size_t nd = nu_ * static_cast<size_t>(s_.nphi);
   // Log-linear interpolation of the MS table in the sun angle (exact for exponential twilight decay).
   const Lerp ls = Locate(sun_theta_rad_, ts);
-  std::vector<float> tsun(nw_), ssc(nw_), st(nw_), acc(nw_), ms0(nw_), ms1(nw_), pc(nc_ * nw_), jv(nw_);
+  std::vector<float> tsun(nw_), ssc(nw_), st(nw_), acc(nw_), ms0(nw_), ms1(nw_), pc(nc_ * nw_), jv(nw_), sst(nw_);
   std::vector<double> tau(nw_), tau_star(nw_), seg_ms(nw_);
   for (size_t d = 0; d < dirs.size(); ++d) {
     const double mu = std::clamp(dirs[d][2], -1.0, 1.0);
@@ -927,7 +956,12 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
             const double cphi2 = std::clamp((nu - mu2 * mus_c) / denom, -1.0, 1.0);
             std::fill(jv.begin(), jv.end(), 0.0f);
             Interpolate(jms_, rr, std::acos(mus_c), mu2, cphi2, 1.0, jv.data());
-            for (size_t w = 0; w < nw_; ++w) seg_ms[w] += 0.5 * h * std::exp(-tau_star[w]) * jv[w];
+            std::fill(sst.begin(), sst.end(), 0.0f);
+            for (size_t c = 0; c < nc_; ++c) {
+              SigmaS(c, rr - R, true, st.data());
+              for (size_t w = 0; w < nw_; ++w) sst[w] += st[w];
+            }
+            for (size_t w = 0; w < nw_; ++w) seg_ms[w] += 0.5 * h * std::exp(-tau_star[w]) * sst[w] * jv[w];
           }
         }
       }
