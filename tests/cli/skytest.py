@@ -78,6 +78,39 @@ class TempDirTestCase(unittest.TestCase):
         return p
 
 
+class PipelineTestCase(TempDirTestCase):
+    """A temporary pipeline folder: subclasses write pipeline.yaml and set self.out (the build
+    folder); these run skybake and ninja there and look at what changed."""
+
+    def bake(self, expect=0):
+        r = run([tool("skybake"), "bake", "pipeline.yaml"], cwd=self.tmp)
+        self.assertEqual(r.returncode, expect, r.stdout + r.stderr)
+        return r
+
+    def ninja(self, *args, expect=0):
+        r = run(["ninja", "-C", self.out] + list(args))
+        self.assertEqual(r.returncode, expect, r.stdout + r.stderr)
+        return r
+
+    def edit(self, rel, old, new):
+        """Replaces the first `old` in file `rel` (which must contain it) with `new`."""
+        p = self.path(rel)
+        with open(p) as f:
+            text = f.read()
+        self.assertIn(old, text)
+        with open(p, "w") as f:
+            f.write(text.replace(old, new, 1))
+
+    def mtimes(self):
+        """Modification times (ns) of every file under the build folder, by relative path."""
+        out = {}
+        for root, _, files in os.walk(self.out):
+            for f in files:
+                p = os.path.join(root, f)
+                out[os.path.relpath(p, self.out)] = os.stat(p).st_mtime_ns
+        return out
+
+
 class CliContract:
     """Mixin: the CLI contract every tool must satisfy (docs/developing.md). Subclasses set
     TOOL and VALID_ARGS (a list, relative to SRC) and may override as needed."""

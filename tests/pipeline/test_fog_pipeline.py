@@ -15,7 +15,7 @@ import sys
 import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "cli"))
-from skytest import SRC, TempDirTestCase, run, tool  # noqa: E402
+from skytest import SRC, PipelineTestCase, run, tool  # noqa: E402
 from test_lut_pipeline import TINY_PARTICLE, edges_run  # noqa: E402
 
 PIPELINE = """outputs: outputs
@@ -42,7 +42,7 @@ fog:
 SKIES = ("clear", "hazed", "cloudy2")
 
 
-class FogPipelineTest(TempDirTestCase):
+class FogPipelineTest(PipelineTestCase):
     def setUp(self):
         super().setUp()
         shutil.copytree(os.path.join(SRC, "atmospheres"), self.path("atmospheres"))
@@ -58,27 +58,6 @@ class FogPipelineTest(TempDirTestCase):
             with open(p, "w") as f:
                 f.write(text)
         self.out = self.path("outputs")
-
-    def ninja(self, *args, expect=0):
-        r = run(["ninja", "-C", self.out] + list(args))
-        self.assertEqual(r.returncode, expect, r.stdout + r.stderr)
-        return r
-
-    def edit(self, rel, old, new):
-        p = self.path(rel)
-        with open(p) as f:
-            text = f.read()
-        self.assertIn(old, text)
-        with open(p, "w") as f:
-            f.write(text.replace(old, new, 1))
-
-    def mtimes(self):
-        out = {}
-        for root, _, files in os.walk(self.out):
-            for f in files:
-                p = os.path.join(root, f)
-                out[os.path.relpath(p, self.out)] = os.stat(p).st_mtime_ns
-        return out
 
     def test_fresh_bake_then_no_work_and_an_edit_reruns_only_its_fog(self):
         r = run([tool("skybake"), "bake", "pipeline.yaml"], cwd=self.tmp)

@@ -12,7 +12,7 @@ import sys
 import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "cli"))
-from skytest import SRC, TempDirTestCase, run, tool  # noqa: E402
+from skytest import SRC, PipelineTestCase, TempDirTestCase, run, tool  # noqa: E402
 
 PIPELINE = """outputs: outputs
 altitude_step_m: 100
@@ -45,7 +45,7 @@ def edges_run(ninja_stdout):
     return [m.group(1) for m in re.finditer(r"^\[\d+/\d+\] (.*)$", ninja_stdout, re.M)]
 
 
-class PipelineTest(TempDirTestCase):
+class PipelineTest(PipelineTestCase):
     def setUp(self):
         super().setUp()
         shutil.copytree(os.path.join(SRC, "atmospheres"), self.path("atmospheres"))
@@ -62,32 +62,6 @@ class PipelineTest(TempDirTestCase):
             with open(p, "w") as f:
                 f.write(text)
         self.out = self.path("outputs")
-
-    def bake(self):
-        r = run([tool("skybake"), "bake", "pipeline.yaml"], cwd=self.tmp)
-        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
-        return r
-
-    def ninja(self, *args, expect=0):
-        r = run(["ninja", "-C", self.out] + list(args))
-        self.assertEqual(r.returncode, expect, r.stdout + r.stderr)
-        return r
-
-    def edit(self, rel, old, new):
-        p = self.path(rel)
-        with open(p) as f:
-            text = f.read()
-        self.assertIn(old, text)
-        with open(p, "w") as f:
-            f.write(text.replace(old, new, 1))
-
-    def mtimes(self):
-        out = {}
-        for root, _, files in os.walk(self.out):
-            for f in files:
-                p = os.path.join(root, f)
-                out[os.path.relpath(p, self.out)] = os.stat(p).st_mtime_ns
-        return out
 
     def test_fresh_bake_then_no_work(self):
         r = self.bake()
