@@ -166,8 +166,21 @@ class OrdersMethod : public SkyMethod {
   void Render(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,
               const ViewSegment* segment, std::vector<double>* out) const;
 
+  // The radius and view-node part of an interpolation: it depends on the point's radius and view
+  // cosine only, so the table rays compute it once, not once per order, sun node and azimuth.
+  struct RadialView {
+    size_t ri = 0;             // lower radius node
+    double wr[2] = {0, 0};     // weights of the radius nodes ri, ri + 1
+    size_t k0[2] = {0, 0}, k1[2] = {0, 0};  // bracketing view nodes at each radius node
+    double tk[2] = {0, 0};     // weight of k1
+  };
+  RadialView RadialViewAt(double r, double mu) const;
   // Interpolates table `tab` (cells x nw) at a point, accumulating weight * value into acc.
   void Interpolate(const std::vector<float>& tab, double r, double theta_s, double mu, double cos_phi, double weight,
+                   float* acc) const {
+    Interpolate(tab, RadialViewAt(r, mu), theta_s, cos_phi, weight, acc);
+  }
+  void Interpolate(const std::vector<float>& tab, const RadialView& rv, double theta_s, double cos_phi, double weight,
                    float* acc) const;
 
   const AtmosphereModel& m_;
@@ -492,9 +505,21 @@ void OrdersMethod::ViewIndex(double mu, double r, size_t* k0, size_t* k1, double
   *t = f - static_cast<double>(i);
 }
 
-void OrdersMethod::Interpolate(const std::vector<float>& tab, double r, double theta_s, double mu, double cos_phi,
-                               double weight, float* acc) const {
+OrdersMethod::RadialView OrdersMethod::RadialViewAt(double r, double mu) const {
+  RadialView v;
   const Lerp lr = Locate(radius_, r);
+  v.ri = lr.i;
+  v.wr[0] = 1.0 - lr.t;
+  v.wr[1] = lr.t;
+  for (int dr = 0; dr < 2; ++dr) {
+    if (v.wr[dr] == 0.0) continue;
+    ViewIndex(mu, radius_[lr.i + static_cast<size_t>(dr)], &v.k0[dr], &v.k1[dr], &v.tk[dr]);
+  }
+  return v;
+}
+
+void OrdersMethod::Interpolate(const std::vector<float>& tab, const RadialView& rv, double theta_s, double cos_phi,
+                               double weight, float* acc) const {
   if (theta_s > sun_theta_rad_.back()) return;  // beyond the last sun node: no light
   const Lerp ls = Locate(sun_theta_rad_, theta_s);
   const double phi = std::acos(std::clamp(cos_phi, -1.0, 1.0));
@@ -503,12 +528,11 @@ void OrdersMethod::Interpolate(const std::vector<float>& tab, double r, double t
   const size_t q0 = std::min(static_cast<size_t>(fq), static_cast<size_t>(s_.nphi - 2));
   const double tq = fq - static_cast<double>(q0);
   for (int dr = 0; dr < 2; ++dr) {
-    const size_t ri = lr.i + static_cast<size_t>(dr);
-    const double wr = dr ? lr.t : 1.0 - lr.t;
+    const size_t ri = rv.ri + static_cast<size_t>(dr);
+    const double wr = rv.wr[dr];
     if (wr == 0.0) continue;
-    size_t k0, k1;
-    double tk;
-    ViewIndex(mu, radius_[ri], &k0, &k1, &tk);
+    const size_t k0 = rv.k0[dr], k1 = rv.k1[dr];
+    const double tk = rv.tk[dr];
     for (int ds = 0; ds < 2; ++ds) {
       const size_t si = ls.i + static_cast<size_t>(ds);
       const double ws = wr * (ds ? ls.t : 1.0 - ls.t);
@@ -541,6 +565,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
     std::vector<double> t, dt, r, mu;
     std::vector<float> trans;  // [step * nw + w]
     std::vector<float> ssc;    // [step * nw + w] scaled scattering coefficient sigma_s* at the step (m^-1)
+    std::vector<RadialView> rv;  // the interpolation's radius/view part at each step
     bool ground = false;
     double d = 0.0;
     std::vector<float> trans_end;  // at the ground
@@ -592,6 +617,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
         const double rr = std::sqrt(r * r + 2.0 * r * mu * tm + tm * tm);
         f.r.push_back(rr);
         f.mu.push_back((r * mu + tm) / rr);
+        f.rv.push_back(RadialViewAt(rr, f.mu.back()));
         for (size_t c = 0; c < nc_; ++c) {
           SigmaS(c, rr - R, true, sc.data());
           for (size_t w = 0; w < nw_; ++w) f.ssc[m * nw_ + w] += sc[w];
@@ -798,7 +824,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
             const double denom = std::sqrt(std::max(1e-12, (1.0 - mu2 * mu2) * (1.0 - mus * mus)));
             const double cphi = (nu - mu2 * mus) / denom;
             std::fill(jv.begin(), jv.end(), 0.0f);
-            Interpolate(J, f.r[m], std::acos(mus), mu2, cphi, f.dt[m], jv.data());
+            Interpolate(J, f.rv[m], std::acos(mus), cphi, f.dt[m], jv.data());
             for (size_t w = 0; w < nw_; ++w) acc[w] += f.trans[m * nw_ + w] * f.ssc[m * nw_ + w] * jv[w];
           }
           if (f.ground) {
