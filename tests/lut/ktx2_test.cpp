@@ -185,7 +185,7 @@ TEST(Ktx2, DfdOfB10G11R11UfloatPack32MatchesTheNotes) {
 
 TEST(Ktx2, DfdRoundTrip) {
   for (const Format& f : {R8Unorm(), R8G8Unorm(), R8G8B8A8Unorm(), R16Sfloat(), R16G16B16A16Sfloat(), R32Sfloat(),
-                          B10G11R11UfloatPack32()}) {
+                          R32G32B32A32Sfloat(), B10G11R11UfloatPack32()}) {
     EXPECT_EQ(DecodeDfd(EncodeDfd(f.dfd), "mem"), f.dfd) << f.name;
   }
 }
@@ -446,6 +446,8 @@ TEST(Texels, EncodeDecodeRoundTripsPerFormat) {
   const std::vector<float> u8 = DecodeTexels(R8G8B8A8Unorm(), EncodeTexels(R8G8B8A8Unorm(), v));
   const std::vector<float> f16 = DecodeTexels(R16Sfloat(), EncodeTexels(R16Sfloat(), v));
   const std::vector<float> f32 = DecodeTexels(R32Sfloat(), EncodeTexels(R32Sfloat(), v));
+  EXPECT_EQ(DecodeTexels(R32G32B32A32Sfloat(), EncodeTexels(R32G32B32A32Sfloat(), v)), v);  // fog-fit's parameter texture
+  EXPECT_EQ(R32G32B32A32Sfloat().texel_block_bytes, 16u);
   ASSERT_EQ(u8.size(), v.size());
   for (size_t i = 0; i < v.size(); ++i) {
     EXPECT_NEAR(u8[i], std::clamp(v[i], 0.0f, 1.0f), 0.5f / 255.0f + 1e-7f) << i;

@@ -77,13 +77,28 @@ SkyLutDecoder SkyLutDecoder::FromKtx2(const ktx2::Texture& t, const std::string&
   const std::vector<double> night = Numbers(t, "skybake.night_rgb", 3, name);
   d.night_ = {night[0], night[1], night[2]};
   d.night_end_rad_ = Numbers(t, "skybake.night_end_zenith_deg", 1, name)[0] * kDeg;
+  const std::string grid = t.GetString("skybake.texel_grid");
+  if (!grid.empty()) {
+    const std::optional<gt7::TexelGrid> g = gt7::ParseTexelGrid(grid);
+    if (!g) throw InputError(FileLoc{name, 0}, "KTX2 key 'skybake.texel_grid' must be \"centres\" or \"nodes\", got \"" + grid + "\"");
+    if (*g == gt7::TexelGrid::kNodes && (d.w_ < 2 || d.h_ < 2)) {
+      throw InputError(FileLoc{name, 0}, "the node texel grid needs at least 2 x 2 texels per slice");
+    }
+    d.grid_ = *g;
+  }
   d.rgb_ = r11g11b10::UnpackTexels(t.data);
   for (float& v : d.rgb_) v = static_cast<float>(v / scale);
   return d;
 }
 
+void SkyLutDecoder::set_texel_grid(gt7::TexelGrid g) {
+  SKYBAKE_CHECK(g == gt7::TexelGrid::kCentres || (w_ >= 2 && h_ >= 2));
+  grid_ = g;
+}
+
 std::array<double, 3> SkyLutDecoder::Sample(int k, double u, double v) const {
-  const double x = u * w_ - 0.5, y = v * h_ - 0.5;
+  const bool nodes = grid_ == gt7::TexelGrid::kNodes;
+  const double x = nodes ? u * (w_ - 1) : u * w_ - 0.5, y = nodes ? v * (h_ - 1) : v * h_ - 0.5;
   const int x0 = std::clamp(static_cast<int>(std::floor(x)), 0, w_ - 1), y0 = std::clamp(static_cast<int>(std::floor(y)), 0, h_ - 1);
   const int x1 = std::min(x0 + 1, w_ - 1), y1 = std::min(y0 + 1, h_ - 1);
   const double fx = std::clamp(x - x0, 0.0, 1.0), fy = std::clamp(y - y0, 0.0, 1.0);
@@ -103,6 +118,15 @@ std::array<double, 3> SkyLutDecoder::SliceRadiance(int k, const std::array<doubl
   return Sample(k, uv[0], uv[1]);
 }
 
+std::pair<int, double> SkyLutDecoder::SliceBlend(double theta) const {
+  const int n = slices();
+  if (theta > time_.SliceZenithRad(n - 1)) return {n - 1, 0.0};
+  const int i = std::min(static_cast<int>(std::floor(time_.SliceCoordinate(theta))), n - 2);
+  const double a_rad = time_.SliceZenithRad(i), b_rad = time_.SliceZenithRad(i + 1);
+  const double t = b_rad > a_rad ? std::clamp((theta - a_rad) / (b_rad - a_rad), 0.0, 1.0) : 0.0;
+  return {i, t};
+}
+
 std::array<double, 3> SkyLutDecoder::Radiance(const std::array<double, 3>& d, double theta) const {
   const int n = slices();
   const double theta_last = time_.SliceZenithRad(n - 1);
@@ -111,9 +135,7 @@ std::array<double, 3> SkyLutDecoder::Radiance(const std::array<double, 3>& d, do
     const std::array<double, 3> last = SliceRadiance(n - 1, d, theta_last);
     return {(1 - f) * last[0] + f * night_[0], (1 - f) * last[1] + f * night_[1], (1 - f) * last[2] + f * night_[2]};
   }
-  const int i = std::min(static_cast<int>(std::floor(time_.SliceCoordinate(theta))), n - 2);
-  const double a_rad = time_.SliceZenithRad(i), b_rad = time_.SliceZenithRad(i + 1);
-  const double t = b_rad > a_rad ? std::clamp((theta - a_rad) / (b_rad - a_rad), 0.0, 1.0) : 0.0;
+  const auto [i, t] = SliceBlend(theta);
   const std::array<double, 3> a = SliceRadiance(i, d, theta);
   if (t <= 0.0) return a;
   const std::array<double, 3> b = SliceRadiance(i + 1, d, theta);

@@ -27,7 +27,9 @@
 //     L = (1 - f) S_last(d, theta_last) + f C,   C = night_rgb (uniform; E_ambient(last) / pi),
 //     theta_end = 108 deg (sun 18 deg below the horizon: astronomical night) by default.
 //   bilinear: texel centres at ((x + 1/2)/W, (y + 1/2)/H), clamp-to-edge in u and v (u's edges are
-//     the sun's vertical plane, where the sky is mirror-symmetric, so clamping is also mirroring).
+//     the sun's vertical plane, where the sky is mirror-symmetric, so clamping is also mirroring);
+//     on the node grid (gt7::TexelGrid::kNodes, fog-fit's fog LUTs: KTX2 key skybake.texel_grid =
+//     "nodes") texel (x, y) is at (x/(W-1), y/(H-1)) instead. Without the key: centres.
 //   Values are divided by the texture's scale (physical units: cd/m^2 in Linear Rec.2020).
 // The decoder works in double; a float32 shader doing the same steps differs by ~1e-6 relative.
 #pragma once
@@ -65,6 +67,13 @@ class SkyLutDecoder {
   const std::string& name() const { return name_; }
   TimeInterpolation time_interpolation() const { return interp_; }
   void set_time_interpolation(TimeInterpolation t) { interp_ = t; }
+  gt7::TexelGrid texel_grid() const { return grid_; }
+  void set_texel_grid(gt7::TexelGrid g);  // kNodes needs W, H >= 2
+
+  // The slices a sun zenith angle theta <= theta_last reads and the weight of the second one: i and
+  // t of the blend above (t = 0 beyond the last slice, i = N - 1 there). Data tied to the slices
+  // (fog-fit's per-slice parameters) are blended with the same i and t.
+  std::pair<int, double> SliceBlend(double sun_zenith_rad) const;
 
   // Bilinear (clamp-to-edge) value of slice k at (u, v), physical units.
   std::array<double, 3> Sample(int k, double u, double v) const;
@@ -84,6 +93,7 @@ class SkyLutDecoder {
   double night_end_rad_ = 0.0;
   std::string name_;
   TimeInterpolation interp_ = TimeInterpolation::kGeometric;
+  gt7::TexelGrid grid_ = gt7::TexelGrid::kCentres;
 };
 
 // GT7's weather blend (gt7-sky-talk.txt, "Interpolation of Basis Skies"): sum_k w_k L_k(d, theta).

@@ -238,7 +238,15 @@ std::array<double, 2> SphereMapping::UvIn(SphereFamily f, const std::array<doubl
   return {Clamp01(std::sqrt(phi / kPi)), LatLongUnwarp(theta / kPi, LatLongK(sun_zenith_rad))};
 }
 
-std::string SphereMapping::Describe() const {
+const char* TexelGridName(TexelGrid g) { return g == TexelGrid::kNodes ? "nodes" : "centres"; }
+
+std::optional<TexelGrid> ParseTexelGrid(const std::string& name) {
+  if (name == "centres") return TexelGrid::kCentres;
+  if (name == "nodes") return TexelGrid::kNodes;
+  return std::nullopt;
+}
+
+std::string SphereMapping::Describe(TexelGrid grid) const {
   return fmt::format(
       "gt7 sphere mapping (gt7-sky-talk.txt, 'Concept Code'; docs/lut-pack.md): u in [0,1] covers the azimuths on "
       "one side of the sun's vertical plane (y >= 0; the other side is the mirror image). Sun zenith <= {} deg "
@@ -246,14 +254,24 @@ std::string SphereMapping::Describe() const {
       "theta from the sun = 2 v' edge (v' <= 1/2) or edge + (2 v' - 1)(pi - edge), edge = pi/2 - atan(cos(phi) "
       "tan(theta_s)), v' = the concept code's transform (a 0.5, b 0.8, c 0.25, d 0.5, p 2; horizon at v = 0.8). "
       "Otherwise latitude-longitude: view zenith pi v' with v' = the K-transform, K = min(1/2, theta_s/pi), azimuth "
-      "from the sun pi u^2. Texel (x, y) at u = (x + 1/2)/W, v = (y + 1/2)/H",
-      FormatExact(90.0 - threshold_elevation_deg), FormatExact(threshold_elevation_deg));
+      "from the sun pi u^2. Texel (x, y) at {}",
+      FormatExact(90.0 - threshold_elevation_deg), FormatExact(threshold_elevation_deg),
+      grid == TexelGrid::kNodes ? "u = x/(W - 1), v = y/(H - 1) (nodes at both ends)" : "u = (x + 1/2)/W, v = (y + 1/2)/H");
+}
+
+std::array<double, 2> Gt7SkyMapping::TexelUv(int x, int y) const {
+  if (grid_ == TexelGrid::kNodes) {
+    SKYBAKE_CHECK(w_ >= 2 && h_ >= 2);
+    return {static_cast<double>(x) / (w_ - 1), static_cast<double>(y) / (h_ - 1)};
+  }
+  return {(x + 0.5) / w_, (y + 0.5) / h_};
 }
 
 std::optional<std::array<double, 3>> Gt7SkyMapping::TexelDirection(int x, int y, double sun_zenith_rad) const {
-  return sphere_.Direction((x + 0.5) / w_, (y + 0.5) / h_, sun_zenith_rad);
+  const std::array<double, 2> uv = TexelUv(x, y);
+  return sphere_.Direction(uv[0], uv[1], sun_zenith_rad);
 }
 
-std::string Gt7SkyMapping::Describe() const { return fmt::format("gt7 {}x{}: ", w_, h_) + sphere_.Describe(); }
+std::string Gt7SkyMapping::Describe() const { return fmt::format("gt7 {}x{}: ", w_, h_) + sphere_.Describe(grid_); }
 
 }  // namespace skybake::gt7

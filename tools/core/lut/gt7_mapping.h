@@ -111,6 +111,19 @@ const char* SphereFamilyName(SphereFamily f);
 
 inline constexpr double kDefaultThresholdElevationDeg = 15.0;
 
+// Where the texels of a W x H slice sit in (u, v) (both grids use the same (u, v) -> direction maps):
+//   kCentres  texel (x, y) at u = (x + 1/2)/W, v = (y + 1/2)/H: lut-pack's sky LUTs (the talk's
+//             concept code samples texel centres);
+//   kNodes    texel (x, y) at u = x/(W - 1), v = y/(H - 1), nodes at both ends (W, H >= 2): fog-fit's
+//             fog LUTs (docs/fog.md, "Texel grid"). The latitude-longitude family then has a row at
+//             v = 0, the zenith (with centres its first row is at view zenith 20 deg for K = 0.42 and
+//             every view above it clamps to that row, whatever its azimuth), and columns on the sun's
+//             vertical plane at both ends. A shader samples texel coordinates ((u (W-1) + 1/2)/W,
+//             (v (H-1) + 1/2)/H), as the fog's attenuation LUT.
+enum class TexelGrid { kCentres, kNodes };
+const char* TexelGridName(TexelGrid g);  // "centres", "nodes"
+std::optional<TexelGrid> ParseTexelGrid(const std::string& name);
+
 // The concept code's nonlinear v transforms and their inverses (each monotonic on [0, 1]).
 double SunAlignedWarp(double v);     // v -> v'
 double SunAlignedUnwarp(double vp);  // v' -> v
@@ -140,14 +153,16 @@ struct SphereMapping {
   // sun-aligned family needs theta_s < 90 deg (InternalError otherwise).
   static std::array<double, 3> DirectionIn(SphereFamily f, double u, double v, double sun_zenith_rad);
   static std::array<double, 2> UvIn(SphereFamily f, const std::array<double, 3>& d, double sun_zenith_rad);
-  std::string Describe() const;
+  // The mapping in words, ending with where the texels of `grid` sit.
+  std::string Describe(TexelGrid grid = TexelGrid::kCentres) const;
 };
 
 // The GT7 sphere mapping as a SkyMapping (sky-render --mapping gt7): W x H texels, each its own
-// mirror (u covers half the azimuths).
+// mirror (u covers half the azimuths), on the texel grid `grid` (kNodes needs W, H >= 2).
 class Gt7SkyMapping : public SkyMapping {
  public:
-  Gt7SkyMapping(int width, int height, SphereMapping sphere = {}) : w_(width), h_(height), sphere_(sphere) {}
+  Gt7SkyMapping(int width, int height, SphereMapping sphere = {}, TexelGrid grid = TexelGrid::kCentres)
+      : w_(width), h_(height), sphere_(sphere), grid_(grid) {}
   std::string Name() const override { return "gt7"; }
   int width() const override { return w_; }
   int height() const override { return h_; }
@@ -155,10 +170,14 @@ class Gt7SkyMapping : public SkyMapping {
   std::array<int, 2> Mirror(int x, int y) const override { return {x, y}; }
   std::string Describe() const override;
   const SphereMapping& sphere() const { return sphere_; }
+  TexelGrid grid() const { return grid_; }
+  // (u, v) of texel (x, y) on this grid.
+  std::array<double, 2> TexelUv(int x, int y) const;
 
  private:
   int w_, h_;
   SphereMapping sphere_;
+  TexelGrid grid_;
 };
 
 }  // namespace skybake::gt7

@@ -158,6 +158,9 @@ Format R16G16B16A16Sfloat() {
   return MakeUnpacked(VkFormat::kR16G16B16A16Sfloat, "R16G16B16A16_SFLOAT", 4, 2, Numeric::kSfloat);
 }
 Format R32Sfloat() { return MakeUnpacked(VkFormat::kR32Sfloat, "R32_SFLOAT", 1, 4, Numeric::kSfloat); }
+Format R32G32B32A32Sfloat() {
+  return MakeUnpacked(VkFormat::kR32G32B32A32Sfloat, "R32G32B32A32_SFLOAT", 4, 4, Numeric::kSfloat);
+}
 
 Format B10G11R11UfloatPack32() {
   Format f;
@@ -178,6 +181,7 @@ Format FormatFor(VkFormat vk) {
     case VkFormat::kR16Sfloat: return R16Sfloat();
     case VkFormat::kR16G16B16A16Sfloat: return R16G16B16A16Sfloat();
     case VkFormat::kR32Sfloat: return R32Sfloat();
+    case VkFormat::kR32G32B32A32Sfloat: return R32G32B32A32Sfloat();
     case VkFormat::kB10G11R11UfloatPack32: return B10G11R11UfloatPack32();
     case VkFormat::kUndefined: break;
   }
@@ -193,6 +197,7 @@ bool IsKnownFormat(uint32_t vk) {
     case VkFormat::kR16Sfloat:
     case VkFormat::kR16G16B16A16Sfloat:
     case VkFormat::kR32Sfloat:
+    case VkFormat::kR32G32B32A32Sfloat:
     case VkFormat::kB10G11R11UfloatPack32:
       return true;
     case VkFormat::kUndefined:
@@ -528,6 +533,7 @@ Codec CodecFor(const Format& f) {
     case VkFormat::kR16G16B16A16Sfloat:
       return Codec::kHalf;
     case VkFormat::kR32Sfloat:
+    case VkFormat::kR32G32B32A32Sfloat:
       return Codec::kFloat32;
     default:
       break;

@@ -59,6 +59,7 @@ enum class VkFormat : uint32_t {
   kR16Sfloat = 76,
   kR16G16B16A16Sfloat = 97,
   kR32Sfloat = 100,
+  kR32G32B32A32Sfloat = 109,
   kB10G11R11UfloatPack32 = 122,
 };
 
@@ -145,6 +146,7 @@ Format R8G8B8A8Unorm();
 Format R16Sfloat();
 Format R16G16B16A16Sfloat();
 Format R32Sfloat();
+Format R32G32B32A32Sfloat();
 // VK_FORMAT_B10G11R11_UFLOAT_PACK32 (122): R in bits 0-10, G in 11-21, B in 22-31, unsigned
 // floats; typeSize 4; DFD values as listed in notes/ninja-ocio-exr-ktx.md §4.2 (vk2dfd.inl).
 // The texel packing itself belongs to lut-pack.
