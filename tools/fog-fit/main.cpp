@@ -1,6 +1,8 @@
 // fog-fit: GT7 global fog from a reference fog render (docs/fog.md).
 //
 //   fog-fit fit FOG.exr -o OUT/fog_<sky>.json [--angle path|elevation] [--channels rgb|luminance]
+//           [--params per-slice-elevation|per-slice|global] [--fit-sun-zenith-deg 30,60,...]
+//           [--fit-elevation-stride N]
 //           [--name SKY] [--ocio-config config.ocio] [--depfile OUT/fog_<sky>.json.d]
 //       FOG.exr: sky-render fog (one basis sky). Fits a and p of
 //       Fog = LUT(dir) (1 - exp(-a theta^p x)) / (1 - exp(-a theta^p)) for the fog and the shadowed fog,
@@ -50,7 +52,9 @@ int main(int argc, char** argv) {
   std::string output, depfile, ocio_config;
 
   CLI::App* fit = cli.app().add_subcommand("fit", "Fit, pack and measure one basis sky's fog");
-  std::string input, name, angle = "path", channels = "rgb";
+  std::string input, name, angle = "path", channels = "rgb", params_mode = "per-slice-elevation";
+  std::vector<double> fit_sza;
+  int fit_elevation_stride = 1;
   fit->add_option("render", input, "FOG.exr: sky-render fog of one basis sky")->required();
   fit->add_option("-o,--output", output, "The parameter file OUT/PREFIX.json; the other products are written beside it")
       ->required();
@@ -59,6 +63,19 @@ int main(int argc, char** argv) {
       ->default_val("path");
   fit->add_option("--channels", channels, "rgb: a, p per Linear Rec.2020 channel (default); luminance: one a, p for all")
       ->default_val("rgb");
+  fit->add_option("--params", params_mode,
+                  std::string("Where a, p live: ") + fog::ParamModeName(fog::ParamMode::kPerSliceElevation) +
+                      " (default: per slice of the fog LUT, a also per elevation node), " +
+                      fog::ParamModeName(fog::ParamMode::kPerSlice) +
+                      " (per slice: fitted per depth table, interpolated in the sun angle) or " +
+                      fog::ParamModeName(fog::ParamMode::kGlobal) + " (one pair per channel: the talk's model); docs/fog.md")
+      ->default_val(fog::ParamModeName(fog::ParamMode::kPerSliceElevation));
+  fit->add_option("--fit-elevation-stride", fit_elevation_stride,
+                  "Fit on every N-th elevation row of the depth tables (and the last; default 1: all); errors are measured on all")
+      ->default_val(1);
+  fit->add_option("--fit-sun-zenith-deg", fit_sza,
+                  "Fit on these depth tables only (sun zenith, deg, comma separated; default all); errors are measured on all")
+      ->delimiter(',');
   fit->add_option("--ocio-config", ocio_config, "OCIO config (default: $SKYBAKE_OCIO or the repo's ocio/config.ocio)");
   fit->add_option("--depfile", depfile, "Write a Make-style depfile of every file read");
 
@@ -79,6 +96,12 @@ int main(int argc, char** argv) {
       o.angle = *a;
       if (channels != "rgb" && channels != "luminance") throw UsageError("--channels: expected rgb or luminance, got '" + channels + "'");
       o.per_channel = channels == "rgb";
+      const std::optional<fog::ParamMode> pm = fog::ParseParamMode(params_mode);
+      if (!pm) throw UsageError("--params: expected per-slice-elevation, per-slice or global, got '" + params_mode + "'");
+      o.params = *pm;
+      o.fit_sun_zenith_deg = fit_sza;
+      if (fit_elevation_stride < 1) throw UsageError("--fit-elevation-stride: expected a whole number >= 1");
+      o.fit_elevation_stride = fit_elevation_stride;
       const std::string file = fs::path(output).filename().string();
       if (file.size() <= 5 || file.substr(file.size() - 5) != ".json") {
         throw UsageError("-o: expected OUT/PREFIX.json (the other products are named PREFIX_*), got '" + output + "'");
@@ -96,7 +119,10 @@ int main(int argc, char** argv) {
 
       Provenance prov;
       prov.tool = cli.name();
-      prov.parameters = fmt::format("subcommand: fit\nname: {}\nangle: {}\nchannels: {}\nprefix: {}\n", name, angle, channels, prefix);
+      std::string fit_list;
+      for (double z : fit_sza) fit_list += (fit_list.empty() ? "" : ", ") + FormatExact(z);
+      prov.parameters = fmt::format("subcommand: fit\nname: {}\nangle: {}\nchannels: {}\nparams: {}\nfit_sun_zenith_deg: [{}]\nfit_elevation_stride: {}\nprefix: {}\n",
+                                    name, angle, channels, params_mode, fit_list, fit_elevation_stride, prefix);
       for (const fs::path& f : files_read) prov.AddInput(f);
       const std::map<std::string, std::string> files = fog::EncodeFogProducts(render, products, prefix, prov);
       const fs::path dir = fs::path(output).parent_path();
@@ -107,10 +133,10 @@ int main(int argc, char** argv) {
       changed += WriteFileIfChanged(output, files.at(file)) ? 1 : 0;  // the edge's output last
       if (!depfile.empty()) WriteDepfile(depfile, output, files_read);
       const fog::ProductStats& s = products.fog_eval;
-      cli.Info(fmt::format("{}: fog a = {:.4g} {:.4g} {:.4g}, p = {:.4g} {:.4g} {:.4g}; evaluator error RMS {:.2f} % "
+      cli.Info(fmt::format("{}: fog ({} parameters) a = {:.4g} {:.4g} {:.4g}, p = {:.4g} {:.4g} {:.4g} (global fit); evaluator error RMS {:.2f} % "
                            "(max {:.1f} %), near the camera {:.2f} % (max {:.1f} %), horizon {:.2f} % (max {:.1f} %); "
                            "{} of {} files changed",
-                           name, products.params.a[0], products.params.a[1], products.params.a[2], products.params.p[0],
+                           name, params_mode, products.params.a[0], products.params.a[1], products.params.a[2], products.params.p[0],
                            products.params.p[1], products.params.p[2], 100 * s.all.rms, 100 * s.all.max, 100 * s.near.rms,
                            100 * s.near.max, 100 * s.horizon.rms, 100 * s.horizon.max, changed, files.size()));
       return;

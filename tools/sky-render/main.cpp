@@ -124,7 +124,7 @@ int main(int argc, char** argv) {
   add_scene_options(fog);
   fog::FogRenderOptions fo;
   double cut_km = 1.0;
-  std::string lut_size = "32x32", att_size = "64x64";
+  std::string lut_size = "32x32", att_size = "64x64", lut_texels = "nodes";
   fog->add_option("--method", fo.method, "orders (deterministic, all orders) or path (the Monte-Carlo reference)")
       ->default_val("orders");
   fog->add_option("--quality", fo.method_options.quality, "orders: low, medium or high")->default_val("medium");
@@ -137,6 +137,11 @@ int main(int argc, char** argv) {
   fog->add_option("--lut-size", lut_size, "Fog LUT slices on the GT7 sphere mapping, WxH")->default_val("32x32");
   fog->add_option("--time-mapping", fo.time_mapping, "GT7 time mapping of the slices: gt7, gt7-quadratic[:<upper>+<lower>]")
       ->default_val("gt7-quadratic");
+  fog->add_option("--lut-texels", lut_texels,
+                  std::string("Texel grid of the slices: ") + gt7::TexelGridName(gt7::TexelGrid::kNodes) +
+                      " (default: x/(W-1), y/(H-1), a row at the zenith) or " + gt7::TexelGridName(gt7::TexelGrid::kCentres) +
+                      " ((x+1/2)/W, lut-pack's; docs/fog.md)")
+      ->default_val("nodes");
   fog->add_option("--sun-zenith-deg", fo.sun_zenith_deg, "Sun zenith angles of the depth tables (deg), comma separated")
       ->delimiter(',')->default_str("30,60,80,88,92,96");
   fog->add_option("--elevations", fo.elevations, "Depth tables: view elevations 90 (i/(m-1))^2 deg, i = 0..m-1")
@@ -157,6 +162,9 @@ int main(int argc, char** argv) {
       };
       size(lut_size, "--lut-size", &fo.lut_width, &fo.lut_height);
       size(att_size, "--attenuation-size", &fo.attenuation_width, &fo.attenuation_height);
+      const std::optional<gt7::TexelGrid> grid = gt7::ParseTexelGrid(lut_texels);
+      if (!grid) throw UsageError("--lut-texels: expected nodes or centres, got '" + lut_texels + "'");
+      fo.texel_grid = *grid;
       if (!(cut_km > 0.0 && cut_km < 1e4)) throw UsageError("--cut-altitude-km: expected a positive altitude in km");
       fo.cut_altitude_m = cut_km * 1e3;
       Scene s = LoadScene(scene, cli.Progress());

@@ -49,7 +49,8 @@ inline std::vector<std::string> FogSkyFiles(const std::string& sky) {
   const std::string p = "fog_" + sky;
   return {p + ".ktx2",          p + "_array.ktx2",      p + ".dds",           p + "_shadowed.ktx2",
           p + "_shadowed_array.ktx2", p + "_shadowed.dds", p + "_attenuation.ktx2", p + "_attenuation.dds",
-          p + ".exr",           p + "_report.json",     p + "_residuals.exr", p + "_residuals.png"};
+          p + "_params.ktx2",   p + ".exr",             p + "_report.json",   p + "_residuals.exr",
+          p + "_residuals.png"};
 }
 
 // outputs/components/particles/<type>.yaml: the canonical component of a particle type (its

@@ -18,6 +18,7 @@
 //     depth_tables: {sun_zenith_deg: [...], elevations: 9, azimuths_deg: [...], depths: 16}
 //     angle: path                  # the fit's normalised angle: path or elevation (the talk's)
 //     channels: rgb                # a, p per channel, or one for all (luminance)
+//     params: per-slice-elevation  # a, p per fog LUT slice, a per elevation too (default); per-slice; global (the talk's)
 //     skies: [clear, hazed]        # atmospheres of the list above
 // One render edge and one fit edge per sky: an edit to one atmosphere re-runs only its two edges
 // (every fit writes only its own sky's files; write-if-changed + restat).
@@ -67,6 +68,7 @@ class FogFitStage : public Stage {
     }
     angle_ = fog->ChoiceOr("angle", {"path", "elevation"}, angle_);
     channels_ = fog->ChoiceOr("channels", {"rgb", "luminance"}, channels_);
+    params_ = fog->ChoiceOr("params", {"per-slice-elevation", "per-slice", "global"}, params_);
     std::set<std::string> seen;
     for (const YamlNode& n : fog->Seq("skies")) {
       const std::optional<std::string> s = n.ToString("the name of an atmosphere of the list above");
@@ -130,7 +132,7 @@ class FogFitStage : public Stage {
       f.rule = "fog_fit";
       f.inputs = r.outputs;
       f.implicit_inputs = {ctx.ToolPath(tool())};
-      f.variables = {{"args", fmt::format("fit --name {} --angle {} --channels {}", a->name, angle_, channels_)}};
+      f.variables = {{"args", fmt::format("fit --name {} --angle {} --channels {} --params {}", a->name, angle_, channels_, params_)}};
       ctx.Build(tool(), f);
     }
     diags.ThrowIfAny();
@@ -176,6 +178,7 @@ class FogFitStage : public Stage {
   int depths_ = 16;
   std::string angle_ = "path";
   std::string channels_ = "rgb";
+  std::string params_ = "per-slice-elevation";
   std::vector<std::pair<std::string, FileLoc>> skies_;
 };
 

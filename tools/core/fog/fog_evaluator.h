@@ -10,6 +10,15 @@
 //   L_c    = fog LUT (GT7 sphere + time mappings, lut/decoder.h: bilinear, geometric slice blend)
 //   S_c    = shadowed fog LUT (the same without the single-scattered sun)
 //   F_c    = (1 - exp(-k_c x)) / (1 - exp(-k_c)),  k_c = a_c theta^p_c   (and k'_c for S)
+//   a_c, p_c: per-slice parameters (the default, docs/fog.md "Per-slice parameters"): slice k of
+//            the fog LUT has its own (a, p) per channel, blended between the two slices the LUT
+//            reads with the LUT's own weight t (lut::SkyLutDecoder::SliceBlend, linear in the sun
+//            angle): a = (1 - t) a_i + t a_{i+1}, p likewise; beyond the last slice the last
+//            slice's. Global (the talk's model, fog-fit --params global): one (a, p) per channel.
+//            Per slice and elevation (fog-fit --params per-slice-elevation): a also depends on the
+//            view elevation: each slice holds a at elevation nodes v_i (v = (elevation/90 deg)^(1/2),
+//            the attenuation LUT's v; the depth tables' elevations), linear in v between them
+//            (clamped at the ends), then blended between slices as above; p stays per slice.
 //   inscattered_c = (1 - o) L_c F_c + o S_c F'_c      o = cloud occlusion in [0, 1] (GT7: "interpolated
 //                                                    with Fog LUT using the cloud occlusion")
 //   T_c    = attenuation LUT, bilinear at u = x^(1/3), v = (elevation / 90 deg)^(1/2), nodes at both
@@ -37,6 +46,15 @@ struct FogParams {
   double planet_radius_m = 6371e3, observer_altitude_m = 0.0, cut_altitude_m = 1000.0;
   std::array<double, 3> a{1, 1, 1}, p{0, 0, 0};                    // fog, per Linear Rec.2020 channel
   std::array<double, 3> a_shadowed{1, 1, 1}, p_shadowed{0, 0, 0};  // shadowed fog
+  // Per-slice parameters, one per slice of the fog LUT (the same for the shadowed fog LUT); empty:
+  // the global a, p above at every sun angle.
+  struct Slice {
+    std::array<double, 3> a{1, 1, 1}, p{0, 0, 0}, a_shadowed{1, 1, 1}, p_shadowed{0, 0, 0};
+    // Per slice and elevation: a at the elevation nodes (empty otherwise; then a above).
+    std::vector<std::array<double, 3>> a_nodes, a_shadowed_nodes;
+  };
+  std::vector<Slice> slices;
+  std::vector<double> node_v;  // elevation nodes v_i = (elevation_i / 90 deg)^(1/2), increasing; empty: no elevation axis
   FogGeometry geometry() const { return FogGeometry(planet_radius_m, observer_altitude_m, cut_altitude_m); }
 };
 
@@ -74,6 +92,9 @@ class FogEvaluator {
   // Fog for unit direction d (local frame of lut/directions.h), object distance depth_m (m; > D
   // means beyond the low atmosphere: x = 1), sun zenith angle, cloud occlusion o in [0, 1].
   FogValue Evaluate(const std::array<double, 3>& d, double depth_m, double sun_zenith_rad, double occlusion = 0.0) const;
+  // The depth function's parameters at this sun zenith angle and view zenith cosine mu (per-slice:
+  // blended; with elevation nodes: a at mu's v; global: a, p). The result's a_nodes are empty.
+  FogParams::Slice ParamsAt(double sun_zenith_rad, double mu = 1.0) const;
   // The LUT terms alone (x = 1, no depth factor): fog and shadowed fog along d.
   std::array<double, 3> LutRadiance(const std::array<double, 3>& d, double sun_zenith_rad, bool shadowed) const;
 

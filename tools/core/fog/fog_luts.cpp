@@ -3,7 +3,11 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <functional>
+#include <optional>
+#include <tuple>
 #include <limits>
 #include <numbers>
 
@@ -93,10 +97,31 @@ double Dot(const std::array<double, 3>& a, const std::array<double, 3>& b) { ret
 
 }  // namespace
 
+const char* ParamModeName(ParamMode m) {
+  switch (m) {
+    case ParamMode::kGlobal:
+      return "global";
+    case ParamMode::kPerSlice:
+      return "per-slice";
+    case ParamMode::kPerSliceElevation:
+      return "per-slice-elevation";
+  }
+  return "?";
+}
+
+std::optional<ParamMode> ParseParamMode(const std::string& name) {
+  for (ParamMode m : {ParamMode::kGlobal, ParamMode::kPerSlice, ParamMode::kPerSliceElevation}) {
+    if (name == ParamModeName(m)) return m;
+  }
+  return std::nullopt;
+}
+
 FogEvaluator MakeEvaluator(const FogProducts& p) {
   const lut::SkyRender& r = p.layout;
   lut::SkyLutDecoder fog(r.width, r.height, r.time, r.sphere, p.fog.decoded_rgb, {0, 0, 0}, p.options.night_end_zenith_deg);
   lut::SkyLutDecoder sh(r.width, r.height, r.time, r.sphere, p.shadowed.decoded_rgb, {0, 0, 0}, p.options.night_end_zenith_deg);
+  fog.set_texel_grid(p.texel_grid);
+  sh.set_texel_grid(p.texel_grid);
   AttenuationLut att(p.attenuation.width, p.attenuation.height, p.attenuation.decoded_rgb);
   return FogEvaluator(p.params, std::move(fog), std::move(sh), std::move(att));
 }
@@ -128,10 +153,32 @@ FogProducts BuildFogProducts(const FogRender& render, const std::string& sky, co
     depth_max[e] = geo.BoundaryDistanceM(mu[e]);
   }
 
-  // ---- Fits. Samples: every table, elevation, azimuth and depth x < 1 of the reference, the
-  // target the fog at x over the fog at x = 1 of the same direction and sun.
-  auto fit_product = [&](const std::vector<std::vector<float>>& data, std::array<FitResult, 3>* fits, std::array<double, 3>* a,
-                         std::array<double, 3>* p) {
+  // ---- Fits. Samples: every (selected) table, elevation, azimuth and depth x < 1 of the reference,
+  // the target the fog at x over the fog at x = 1 of the same direction and sun.
+  const size_t n_fit_tables = [&] {
+    out.table_in_fit.assign(n_tab, o.fit_sun_zenith_deg.empty());
+    for (double z : o.fit_sun_zenith_deg) {
+      bool found = false;
+      for (size_t s = 0; s < n_tab; ++s) {
+        if (std::fabs(render.tables[s].sun_zenith_deg - z) <= 1e-9) {
+          out.table_in_fit[s] = true;
+          found = true;
+        }
+      }
+      if (!found) {
+        std::string have;
+        for (const FogDepthTable& t : render.tables) have += (have.empty() ? "" : ", ") + FormatExact(t.sun_zenith_deg);
+        throw UsageError(fmt::format("--fit-sun-zenith-deg: {} deg is not a depth table of {} ({} deg)", FormatExact(z),
+                                     render.path, have));
+      }
+    }
+    return static_cast<size_t>(std::count(out.table_in_fit.begin(), out.table_in_fit.end(), true));
+  }();
+  SKYBAKE_CHECK(n_fit_tables > 0);
+  // Fits (a, p) per channel (or once on luminance, copied to R, G, B) on the samples of the
+  // (table, azimuth, elevation) triples `use` selects (one elevation: p = 0, k = a).
+  auto fit_on = [&](const std::vector<std::vector<float>>& data, const std::function<bool(size_t, size_t, size_t)>& use) {
+    std::array<FitResult, 3> fits;
     const int channels = o.per_channel ? 3 : 1;
     for (int c = 0; c < channels; ++c) {
       std::vector<FitSample> samples;
@@ -139,6 +186,7 @@ FogProducts BuildFogProducts(const FogRender& render, const std::string& sky, co
       for (size_t s = 0; s < n_tab; ++s) {
         for (size_t e = 0; e < ne; ++e) {
           for (size_t az = 0; az < na; ++az) {
+            if (!use(s, az, e)) continue;
             const size_t i1 = render.TableIndex(e, az, nx - 1);
             const double v1 = o.per_channel ? data[s][i1 * 3 + c] : Dot(y_row, {data[s][i1 * 3], data[s][i1 * 3 + 1], data[s][i1 * 3 + 2]});
             for (size_t j = 0; j + 1 < nx; ++j) {
@@ -150,11 +198,14 @@ FogProducts BuildFogProducts(const FogRender& render, const std::string& sky, co
         }
       }
       const FitResult f = FitDepthFactor(samples, o.fit);
-      for (int k = (o.per_channel ? c : 0); k < (o.per_channel ? c + 1 : 3); ++k) {
-        (*fits)[static_cast<size_t>(k)] = f;
-        (*a)[static_cast<size_t>(k)] = f.a;
-        (*p)[static_cast<size_t>(k)] = f.p;
-      }
+      for (int k = (o.per_channel ? c : 0); k < (o.per_channel ? c + 1 : 3); ++k) fits[static_cast<size_t>(k)] = f;
+    }
+    return fits;
+  };
+  auto as_params = [](const std::array<FitResult, 3>& f, std::array<double, 3>* a, std::array<double, 3>* p) {
+    for (size_t c = 0; c < 3; ++c) {
+      (*a)[c] = f[c].a;
+      (*p)[c] = f[c].p;
     }
   };
   FogParams& par = out.params;
@@ -163,8 +214,108 @@ FogProducts BuildFogProducts(const FogRender& render, const std::string& sky, co
   par.planet_radius_m = render.planet_radius_m;
   par.observer_altitude_m = render.observer_altitude_m;
   par.cut_altitude_m = render.cut_altitude_m;
-  fit_product(ref, &out.fit_fog, &par.a, &par.p);
-  fit_product(ref_sh, &out.fit_shadowed, &par.a_shadowed, &par.p_shadowed);
+  // Elevations the fits use: every fit_elevation_stride-th row of the tables, and the last.
+  SKYBAKE_CHECK(o.fit_elevation_stride >= 1);
+  out.elevation_in_fit.assign(ne, false);
+  for (size_t e = 0; e < ne; e += static_cast<size_t>(o.fit_elevation_stride)) out.elevation_in_fit[e] = true;
+  out.elevation_in_fit[ne - 1] = true;
+  auto in_fit = [&](size_t s, size_t e) { return out.table_in_fit[s] && out.elevation_in_fit[e]; };
+  out.fit_fog = fit_on(ref, [&](size_t s, size_t, size_t e) { return in_fit(s, e); });
+  out.fit_shadowed = fit_on(ref_sh, [&](size_t s, size_t, size_t e) { return in_fit(s, e); });
+  as_params(out.fit_fog, &par.a, &par.p);
+  as_params(out.fit_shadowed, &par.a_shadowed, &par.p_shadowed);
+  // Per depth table (the diagnostics use every table; the per-slice parameters the selected ones).
+  out.table_fit_fog.resize(n_tab);
+  out.table_fit_shadowed.resize(n_tab);
+  for (size_t s = 0; s < n_tab; ++s) {
+    out.table_fit_fog[s] = fit_on(ref, [&](size_t s2, size_t, size_t e) { return s2 == s && out.elevation_in_fit[e]; });
+    out.table_fit_shadowed[s] = fit_on(ref_sh, [&](size_t s2, size_t, size_t e) { return s2 == s && out.elevation_in_fit[e]; });
+  }
+  if (o.params != ParamMode::kGlobal) {
+    // Per slice: ln a and p piecewise linear in the sun zenith angle between the selected tables
+    // whose fit had samples (sorted by angle), constant beyond the first and the last.
+    // `weights(fits, sza)`: (table lo, table hi, weight of hi), or nullopt without usable tables.
+    auto weights = [&](const std::vector<std::array<FitResult, 3>>& fits, double sza) -> std::optional<std::tuple<size_t, size_t, double>> {
+      std::vector<std::pair<double, size_t>> nodes;
+      for (size_t s = 0; s < n_tab; ++s) {
+        if (out.table_in_fit[s] && fits[s][0].used > 0 && fits[s][1].used > 0 && fits[s][2].used > 0) {
+          nodes.push_back({render.tables[s].sun_zenith_deg, s});
+        }
+      }
+      std::sort(nodes.begin(), nodes.end());
+      if (nodes.empty()) return std::nullopt;
+      size_t hi = 0;
+      while (hi < nodes.size() && nodes[hi].first < sza) ++hi;
+      const size_t lo = hi == 0 ? 0 : hi - 1;
+      hi = std::min(hi, nodes.size() - 1);
+      const double w = nodes[hi].first > nodes[lo].first ? std::clamp((sza - nodes[lo].first) / (nodes[hi].first - nodes[lo].first), 0.0, 1.0) : 0.0;
+      return std::tuple<size_t, size_t, double>{nodes[lo].second, nodes[hi].second, w};
+    };
+    // Per slice and elevation: for each selected table s and fit elevation e, k fitted on that
+    // elevation alone (all azimuths; one theta, so the fit's a is k), stored as a_se = k / theta_e^p_s
+    // with the table's own p: a_se = a_s reproduces the per-slice model, and theta^p keeps the
+    // fast variation of k near the horizon out of the interpolation in v.
+    std::vector<size_t> nodes_e;
+    for (size_t e = 0; e < ne; ++e) {
+      if (out.elevation_in_fit[e]) nodes_e.push_back(e);
+    }
+    std::vector<std::vector<std::array<double, 3>>> a_se(n_tab), a_se_sh(n_tab);
+    if (o.params == ParamMode::kPerSliceElevation) {
+      for (double v_e : [&] {
+             std::vector<double> v;
+             for (size_t e : nodes_e) v.push_back(AttenuationV(mu[e]));
+             return v;
+           }()) {
+        par.node_v.push_back(v_e);
+      }
+      for (size_t s = 0; s < n_tab; ++s) {
+        if (!out.table_in_fit[s]) continue;
+        for (int prod = 0; prod < 2; ++prod) {
+          const std::array<FitResult, 3>& table = prod ? out.table_fit_shadowed[s] : out.table_fit_fog[s];
+          auto& dst = prod ? a_se_sh[s] : a_se[s];
+          for (size_t e : nodes_e) {
+            const std::array<FitResult, 3> k = fit_on(prod ? ref_sh : ref, [&](size_t s2, size_t, size_t e2) { return s2 == s && e2 == e; });
+            std::array<double, 3> v{};
+            for (size_t c = 0; c < 3; ++c) {
+              // No usable sample at this elevation: the table's own a.
+              v[c] = k[c].used > 0 ? k[c].a / DepthExponent(1.0, table[c].p, theta[e]) : table[c].a;
+            }
+            dst.push_back(v);
+          }
+        }
+      }
+    }
+    for (double sza : render.slice_zenith_deg) {
+      FogParams::Slice q;
+      for (int prod = 0; prod < 2; ++prod) {
+        const std::vector<std::array<FitResult, 3>>& fits = prod ? out.table_fit_shadowed : out.table_fit_fog;
+        const std::array<FitResult, 3>& global = prod ? out.fit_shadowed : out.fit_fog;
+        std::array<double, 3>& a = prod ? q.a_shadowed : q.a;
+        std::array<double, 3>& p = prod ? q.p_shadowed : q.p;
+        std::vector<std::array<double, 3>>& an = prod ? q.a_shadowed_nodes : q.a_nodes;
+        const auto wt = weights(fits, sza);
+        if (!wt) {
+          as_params(global, &a, &p);
+          if (o.params == ParamMode::kPerSliceElevation) an.assign(nodes_e.size(), a);
+          continue;
+        }
+        const auto [lo, hi, w] = *wt;
+        for (size_t c = 0; c < 3; ++c) {
+          a[c] = std::exp((1 - w) * std::log(fits[lo][c].a) + w * std::log(fits[hi][c].a));
+          p[c] = (1 - w) * fits[lo][c].p + w * fits[hi][c].p;
+        }
+        if (o.params == ParamMode::kPerSliceElevation) {
+          const auto& A = prod ? a_se_sh : a_se;
+          for (size_t j = 0; j < nodes_e.size(); ++j) {
+            std::array<double, 3> v{};
+            for (size_t c = 0; c < 3; ++c) v[c] = std::exp((1 - w) * std::log(A[lo][j][c]) + w * std::log(A[hi][j][c]));
+            an.push_back(v);
+          }
+        }
+      }
+      par.slices.push_back(q);
+    }
+  }
 
   // ---- Pack the LUTs.
   lut::SkyRender& lay = out.layout;
@@ -177,6 +328,7 @@ FogProducts BuildFogProducts(const FogRender& render, const std::string& sky, co
   lay.slice_zenith_deg = render.slice_zenith_deg;
   lay.observer = render.observer;
   lay.method = render.method;
+  out.texel_grid = render.texel_grid;
   const int n_slices = static_cast<int>(render.slice_zenith_deg.size());
   auto pack_slices = [&](const std::vector<std::vector<float>>& slices) {
     std::vector<float> rgb;
@@ -235,6 +387,7 @@ FogProducts BuildFogProducts(const FogRender& render, const std::string& sky, co
   for (size_t s = 0; s < n_tab; ++s) {
     const double sza = render.tables[s].sun_zenith_deg;
     for (size_t e = 0; e < ne; ++e) {
+      const FogParams::Slice q = eval.ParamsAt(sza * kDeg, mu[e]);  // what the evaluator uses at this sun angle and elevation
       for (size_t az = 0; az < na; ++az) {
         const std::array<double, 3> dir = DirOf(render.elevation_deg[e], render.azimuth_deg[az]);
         const size_t i1 = render.TableIndex(e, az, nx - 1);
@@ -259,8 +412,8 @@ FogProducts BuildFogProducts(const FogRender& render, const std::string& sky, co
               ++noise_n;
             }
             std::array<double, 3> fit{}, ev = prod ? vs.inscattered : v.inscattered;
-            const std::array<double, 3>& a = prod ? par.a_shadowed : par.a;
-            const std::array<double, 3>& p = prod ? par.p_shadowed : par.p;
+            const std::array<double, 3>& a = prod ? q.a_shadowed : q.a;
+            const std::array<double, 3>& p = prod ? q.p_shadowed : q.p;
             for (int c = 0; c < 3; ++c) fit[c] = r1[c] * DepthFactor(x, DepthExponent(a[c], p[c], theta[e]));
             for (int src = 0; src < 2; ++src) {
               const std::array<double, 3>& m = src ? ev : fit;
@@ -299,6 +452,66 @@ FogProducts BuildFogProducts(const FogRender& render, const std::string& sky, co
   out.shadowed_eval = acc[3].Done();
   out.reference_noise_rms = noise_n ? std::sqrt(noise2 / static_cast<double>(noise_n)) : 0.0;
 
+  // ---- Diagnostics: the fog's fit error (luminance) with other parameter choices on the same
+  // samples. `params(s, az, e)` gives (a, p) per channel for table s, azimuth az, elevation e.
+  using ParamPair = std::pair<std::array<double, 3>, std::array<double, 3>>;
+  auto diagnose = [&](const std::string& name, const std::string& description,
+                      const std::function<ParamPair(size_t, size_t, size_t)>& params) {
+    Accumulator all, near, horizon;
+    for (size_t s = 0; s < n_tab; ++s) {
+      const double sza = render.tables[s].sun_zenith_deg;
+      for (size_t az = 0; az < na; ++az) {
+        for (size_t e = 0; e < ne; ++e) {
+          const ParamPair q = params(s, az, e);
+          const std::array<double, 3> r1{ref[s][render.TableIndex(e, az, nx - 1) * 3], ref[s][render.TableIndex(e, az, nx - 1) * 3 + 1],
+                                         ref[s][render.TableIndex(e, az, nx - 1) * 3 + 2]};
+          for (size_t j = 0; j < nx; ++j) {
+            const size_t i = render.TableIndex(e, az, j);
+            const std::array<double, 3> rc{ref[s][i * 3], ref[s][i * 3 + 1], ref[s][i * 3 + 2]};
+            const double y_ref = Dot(y_row, rc);
+            if (!(y_ref > 0.0)) continue;
+            std::array<double, 3> m;
+            for (size_t c = 0; c < 3; ++c) m[c] = r1[c] * DepthFactor(render.depth_x[j], DepthExponent(q.first[c], q.second[c], theta[e]));
+            const double err = Dot(y_row, m) / y_ref - 1.0;
+            const std::array<double, 3> ec{0, 0, 0};
+            const double depth_m = render.depth_x[j] * depth_max[e], elev = render.elevation_deg[e], azd = render.azimuth_deg[az];
+            all.Add(err, ec, sza, elev, azd, depth_m, render.depth_x[j]);
+            if (depth_m <= o.near_depth_m) near.Add(err, ec, sza, elev, azd, depth_m, render.depth_x[j]);
+            if (elev <= o.horizon_elevation_deg) horizon.Add(err, ec, sza, elev, azd, depth_m, render.depth_x[j]);
+          }
+        }
+      }
+    }
+    out.diagnostics.push_back({name, description, all.Done(), near.Done(), horizon.Done()});
+  };
+  auto pair_of = [](const std::array<FitResult, 3>& f) {
+    return ParamPair{{f[0].a, f[1].a, f[2].a}, {f[0].p, f[1].p, f[2].p}};
+  };
+  diagnose("global", "one (a, p) per channel for every sun angle (the talk's model), fitted on the fit's tables",
+           [&](size_t, size_t, size_t) { return pair_of(out.fit_fog); });
+  diagnose("per_table", "(a, p) fitted on each depth table alone (in-sample: the best any per-sun-angle model can do here)",
+           [&](size_t s, size_t, size_t) { return pair_of(out.table_fit_fog[s]); });
+  {
+    std::vector<std::vector<std::array<FitResult, 3>>> per_az(n_tab, std::vector<std::array<FitResult, 3>>(na));
+    for (size_t s = 0; s < n_tab; ++s) {
+      for (size_t az = 0; az < na; ++az) {
+        per_az[s][az] = fit_on(ref, [&](size_t s2, size_t a2, size_t) { return s2 == s && a2 == az; });
+      }
+    }
+    diagnose("per_table_and_azimuth",
+             "(a, p) fitted on each depth table and view azimuth alone (in-sample: what an azimuth dimension would add)",
+             [&](size_t s, size_t az, size_t) { return pair_of(per_az[s][az]); });
+    // k per depth table and elevation (all azimuths): one theta per fit, so p = 0 and k = a.
+    std::vector<std::vector<std::array<FitResult, 3>>> per_el(n_tab, std::vector<std::array<FitResult, 3>>(ne));
+    for (size_t s = 0; s < n_tab; ++s) {
+      for (size_t e = 0; e < ne; ++e) per_el[s][e] = fit_on(ref, [&](size_t s2, size_t, size_t e2) { return s2 == s && e2 == e; });
+    }
+    diagnose("per_table_and_elevation",
+             "k fitted on each depth table and view elevation alone, all azimuths (in-sample: a k table over sun angle x "
+             "elevation instead of a theta^p)",
+             [&](size_t s, size_t, size_t e) { return pair_of(per_el[s][e]); });
+  }
+
   // Attenuation LUT vs the exact transmittance at the depth tables' points.
   std::array<double, 3> sum2{0, 0, 0};
   size_t n = 0;
@@ -334,9 +547,27 @@ std::string ModelText(const FogParams& p) {
   return fmt::format(
       "Fog(dir, d) = LUT(dir) (1 - exp(-a theta^p x)) / (1 - exp(-a theta^p)) per Linear Rec.2020 channel, "
       "x = min(d / D, 1), D = distance from the observer to the cut sphere (altitude {} m) along dir, directions below "
-      "the horizon clamped to it; theta = {}; docs/fog.md",
+      "the horizon clamped to it; theta = {}; a, p {}; docs/fog.md",
       FormatExact(p.cut_altitude_m),
-      p.angle == AngleDefinition::kPath ? "(cut - observer altitude) / D (path)" : "elevation / 90 deg (elevation)");
+      p.angle == AngleDefinition::kPath ? "(cut - observer altitude) / D (path)" : "elevation / 90 deg (elevation)",
+      p.slices.empty()    ? "global (one pair per channel)"
+      : p.node_v.empty()  ? "per slice of the fog LUT, blended between slices as the LUT"
+                          : "per slice of the fog LUT (a also per elevation node, linear in v = (elevation/90 deg)^(1/2)), "
+                            "blended between slices as the LUT");
+}
+
+std::string PerSliceText() {
+  return "a and p per slice of the fog LUT (row k: slice k, R, G, B): fitted per depth table, ln a and p linear in the "
+         "sun zenith angle between the tables, constant beyond the first and the last; the runtime blends rows i and "
+         "i + 1 linearly with the LUT's slice weight t (a = (1 - t) a_i + t a_i+1; beyond the last slice the last row); "
+         "docs/fog.md";
+}
+
+std::string ElevationNodesText() {
+  return "a per slice (outer list) and elevation node (inner list: nodes at v = (elevation/90 deg)^(1/2), the depth "
+         "tables' elevations) per channel: the depth exponent is k = a(v) theta^p with a linear in v between the nodes "
+         "(clamped at the ends) and p the slice's; fitted per depth table and elevation as a = k / theta^p, ln a linear "
+         "in the sun zenith angle between the tables; docs/fog.md";
 }
 
 ExrImage InspectionImage(int width, int height, const lut::PackedTexture& t, const Provenance& prov, const std::string& quantity) {
@@ -450,9 +681,104 @@ std::array<uint8_t, 3> Diverging(float e, double range) {
 std::vector<std::string> FogProductFiles(const std::string& P) {
   return {P + ".json",         P + ".ktx2",          P + "_array.ktx2",          P + ".dds",
           P + "_shadowed.ktx2", P + "_shadowed_array.ktx2", P + "_shadowed.dds", P + "_attenuation.ktx2",
-          P + "_attenuation.dds", P + ".exr",         P + "_report.json",         P + "_residuals.exr",
-          P + "_residuals.png"};
+          P + "_attenuation.dds", P + "_params.ktx2", P + ".exr",                P + "_report.json",
+          P + "_residuals.exr", P + "_residuals.png"};
 }
+
+namespace {
+
+// nlohmann's dump(2) puts every number of an array on its own line; arrays holding only numbers
+// are written on one line instead (the per-slice tables would otherwise be 100 KB of indentation).
+std::string CompactNumberArrays(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  size_t i = 0;
+  while (i < text.size()) {
+    if (text[i] == '[') {
+      size_t j = i + 1;
+      bool numeric = true, any = false;
+      while (j < text.size() && text[j] != ']') {
+        const char c = text[j];
+        if (std::isdigit(static_cast<unsigned char>(c)) || c == '-' || c == '+' || c == '.' || c == 'e' || c == 'E') {
+          any = true;
+        } else if (!(c == ',' || c == ' ' || c == '\n')) {
+          numeric = false;
+          break;
+        }
+        ++j;
+      }
+      if (numeric && any && j < text.size()) {
+        out += '[';
+        bool space = false;
+        for (size_t k = i + 1; k < j; ++k) {
+          const char c = text[k];
+          if (c == ' ' || c == '\n') continue;
+          if (space) out += ' ';
+          space = false;
+          out += c;
+          if (c == ',') space = true;
+        }
+        out += ']';
+        i = j + 1;
+        continue;
+      }
+    }
+    out += text[i++];
+  }
+  return out;
+}
+
+// The depth function's parameters as a tiny texture for a shader (docs/fog.md, "Files"):
+// R32G32B32A32_SFLOAT (a reaches 1e-5 on a Rayleigh-only sky: below half's normal range), W = 1 + nodes (1 without elevation nodes), H = slices, 2 layers (0 fog, 1
+// shadowed fog); texel (0, k) = (p_R, p_G, p_B, 0) of slice k, texel (1 + j, k) = (a_R, a_G, a_B, 1)
+// at elevation node j. Global parameters are written as the same row in every slice.
+ktx2::Texture ParamsTexture(const FogProducts& p, const std::vector<double>& slice_zenith_deg, const Provenance& prov) {
+  const FogParams& par = p.params;
+  const size_t n_slices = slice_zenith_deg.size(), nodes = std::max<size_t>(par.node_v.size(), 1);
+  std::vector<float> v;
+  for (int prod = 0; prod < 2; ++prod) {
+    for (size_t k = 0; k < n_slices; ++k) {
+      const FogParams::Slice q = par.slices.empty()
+                                     ? FogParams::Slice{par.a, par.p, par.a_shadowed, par.p_shadowed, {}, {}}
+                                     : par.slices[k];
+      const std::array<double, 3>& pp = prod ? q.p_shadowed : q.p;
+      for (double x : pp) v.push_back(static_cast<float>(x));
+      v.push_back(0.0f);
+      const std::vector<std::array<double, 3>>& an = prod ? q.a_shadowed_nodes : q.a_nodes;
+      for (size_t j = 0; j < nodes; ++j) {
+        const std::array<double, 3>& a = an.empty() ? (prod ? q.a_shadowed : q.a) : an[j];
+        for (double x : a) v.push_back(static_cast<float>(x));
+        v.push_back(1.0f);
+      }
+    }
+  }
+  ktx2::Texture tex;
+  tex.format = ktx2::R32G32B32A32Sfloat();
+  tex.width = static_cast<uint32_t>(1 + nodes);
+  tex.height = static_cast<uint32_t>(n_slices);
+  tex.layers = 2;
+  tex.data = ktx2::EncodeTexels(tex.format, v);
+  ktx2::SetProvenance(tex, prov);
+  ktx2::SetString(tex, "KTXorientation", "rd");
+  ktx2::SetString(tex, "skybake.basis_sky", p.sky);
+  ktx2::SetString(tex, "skybake.quantity",
+                  "GT7 fog depth function k = a theta^p per Linear Rec.2020 channel (docs/fog.md): layer 0 the fog, layer 1 "
+                  "the shadowed fog; row k = slice k of the fog LUT; texel 0 = (p_R, p_G, p_B, 0), texel 1 + j = (a_R, a_G, "
+                  "a_B, 1) at elevation node j (one node: a for every elevation); float32 of the parameter file's doubles");
+  std::string nv, sz;
+  for (double x : par.node_v) nv += (nv.empty() ? "" : " ") + FormatExact(x);
+  for (double x : slice_zenith_deg) sz += (sz.empty() ? "" : " ") + FormatExact(x);
+  ktx2::SetString(tex, "skybake.fog.parameters_mode", ParamModeName(p.options.params));
+  ktx2::SetString(tex, "skybake.fog.elevation_nodes_v", nv.empty() ? "none" : nv);
+  ktx2::SetString(tex, "skybake.slice_zenith_deg", sz);
+  ktx2::SetString(tex, "skybake.sampling",
+                  "per slice: a linear in v = (elevation/90 deg)^(1/2) between the nodes (uniform in v for the pipeline's "
+                  "depth tables: texel coordinate (1 + v (W - 2) + 1/2)/W), clamped at the ends; rows i and i + 1 blended "
+                  "with the fog LUT's slice weight t (linear in the sun zenith angle); beyond the last slice the last row");
+  return tex;
+}
+
+}  // namespace
 
 std::map<std::string, std::string> EncodeFogProducts(const FogRender& r, const FogProducts& p, const std::string& P,
                                                      const Provenance& prov) {
@@ -473,8 +799,9 @@ std::map<std::string, std::string> EncodeFogProducts(const FogRender& r, const F
                     std::string(shadowed ? "shadowed fog (no single-scattered sun)" : "fog") +
                         " of the whole low-atmosphere segment (x = 1): in-scattered radiance (cd/m^2 of luminance) in "
                         "Linear Rec.2020, times skybake.scale; texel (x, y, slice) is the direction of the GT7 sphere "
-                        "mapping at u = (x + 1/2)/W, v = (y + 1/2)/H for the sun zenith angle of the slice; directions "
-                        "below the horizon hold the horizon's value");
+                        "mapping at " +
+                        std::string(p.texel_grid == gt7::TexelGrid::kNodes ? "u = x/(W - 1), v = y/(H - 1)" : "u = (x + 1/2)/W, v = (y + 1/2)/H") +
+                        " for the sun zenith angle of the slice; directions below the horizon hold the horizon's value");
     ktx2::SetString(tex, "skybake.night",
                     fmt::format("below the last slice (sun zenith {} deg) the decoded fog moves linearly to 0, reached at "
                                 "sun zenith {} deg",
@@ -482,6 +809,19 @@ std::map<std::string, std::string> EncodeFogProducts(const FogRender& r, const F
     ktx2::SetString(tex, "skybake.fog.model", ModelText(p.params));
     ktx2::SetString(tex, "skybake.fog.cut_altitude_m", FormatExact(r.cut_altitude_m));
     ktx2::SetString(tex, "skybake.fog.parameters", P + ".json");
+    ktx2::SetString(tex, "skybake.fog.parameters_texture", P + "_params.ktx2");
+    ktx2::SetString(tex, "skybake.fog.parameters_mode", ParamModeName(p.options.params));
+    if (p.texel_grid == gt7::TexelGrid::kNodes) {
+      ktx2::SetString(tex, "skybake.texel_grid", gt7::TexelGridName(p.texel_grid));
+      ktx2::SetString(tex, "skybake.sphere_mapping", p.layout.sphere.Describe(p.texel_grid));
+      ktx2::SetString(tex, "skybake.sampling",
+                      "texel (x, y) is the node u = x/(W - 1), v = y/(H - 1) of the sphere mapping: sample at texel "
+                      "coordinates ((u (W - 1) + 1/2)/W, (v (H - 1) + 1/2)/H), bilinear, clamp-to-edge; slices as lut-pack's "
+                      "sky LUTs: slice coordinate s of the sun zenith theta from the time mapping, slices i = min(floor(s), "
+                      "N - 2) and i + 1, each read with its own sphere-mapping family at the target sun zenith (sun-aligned "
+                      "slices at min(theta, threshold zenith)), blended geometrically per channel, max(a, 1e-6)^(1 - t) "
+                      "max(b, 1e-6)^t with t = (theta - theta_i)/(theta_i+1 - theta_i) (docs/fog.md, docs/lut-pack.md)");
+    }
     return ktx2::EncodeKtx2(tex);
   };
   auto dds = [](const lut::PackedTexture& t, bool volume) {
@@ -524,6 +864,7 @@ std::map<std::string, std::string> EncodeFogProducts(const FogRender& r, const F
     out[P + "_attenuation.ktx2"] = ktx2::EncodeKtx2(tex);
   }
   out[P + "_attenuation.dds"] = dds(p.attenuation, false);
+  out[P + "_params.ktx2"] = ktx2::EncodeKtx2(ParamsTexture(p, r.slice_zenith_deg, prov));
 
   // ---- Inspection EXR.
   {
@@ -559,8 +900,36 @@ std::map<std::string, std::string> EncodeFogProducts(const FogRender& r, const F
     m["boundary_distance_zenith_m"] = geo.BoundaryDistanceM(1.0);
     m["boundary_distance_horizon_m"] = geo.BoundaryDistanceM(0.0);
     m["units"] = "a, p, x and theta are dimensionless; depths in m; LUT radiance in cd/m^2 (Linear Rec.2020)";
+    m["parameters"] = ParamModeName(p.options.params);
     m["fog"] = {{"a", p.params.a}, {"p", p.params.p}};
     m["shadowed"] = {{"a", p.params.a_shadowed}, {"p", p.params.p_shadowed}};
+    if (!p.params.slices.empty()) {
+      Json fa = Json::array(), fp = Json::array(), sa = Json::array(), sp = Json::array();
+      for (const FogParams::Slice& q : p.params.slices) {
+        fa.push_back(q.a);
+        fp.push_back(q.p);
+        sa.push_back(q.a_shadowed);
+        sp.push_back(q.p_shadowed);
+      }
+      m["per_slice"] = {{"description", PerSliceText()},
+                        {"sun_zenith_deg", r.slice_zenith_deg},
+                        {"fog", {{"a", fa}, {"p", fp}}},
+                        {"shadowed", {{"a", sa}, {"p", sp}}}};
+      if (!p.params.node_v.empty()) {
+        Json ea = Json::array(), esa = Json::array();
+        for (const FogParams::Slice& q : p.params.slices) {
+          ea.push_back(q.a_nodes);
+          esa.push_back(q.a_shadowed_nodes);
+        }
+        std::vector<double> el;
+        for (double v : p.params.node_v) el.push_back(90.0 * v * v);
+        m["per_slice"]["elevation_nodes"] = {{"description", ElevationNodesText()},
+                                             {"v", p.params.node_v},
+                                             {"elevation_deg", el},
+                                             {"fog", {{"a", ea}}},
+                                             {"shadowed", {{"a", esa}}}};
+      }
+    }
     j["model"] = m;
     j["files"] = {{"fog", P + ".ktx2"},
                   {"fog_array", P + "_array.ktx2"},
@@ -570,9 +939,10 @@ std::map<std::string, std::string> EncodeFogProducts(const FogRender& r, const F
                   {"shadowed_dds", P + "_shadowed.dds"},
                   {"attenuation", P + "_attenuation.ktx2"},
                   {"attenuation_dds", P + "_attenuation.dds"},
+                  {"parameters_texture", P + "_params.ktx2"},
                   {"report", P + "_report.json"}};
     j["skybake"] = ProvenanceJson(prov);
-    out[P + ".json"] = j.dump(2) + "\n";
+    out[P + ".json"] = CompactNumberArrays(j.dump(2)) + "\n";
   }
 
   // ---- Report.
@@ -595,22 +965,38 @@ std::map<std::string, std::string> EncodeFogProducts(const FogRender& r, const F
     j["definitions"] = {
         {"error", "relative luminance error Y_model / Y_reference - 1 (Y from Linear Rec.2020 by OCIO); channel_rms: the "
                   "same per Rec.2020 channel"},
-        {"fit", "the model with the exact reference at x = 1: LUT(dir) = Fog_ref(dir, 1) (the depth function's error)"},
+        {"fit", "the model with the exact reference at x = 1: LUT(dir) = Fog_ref(dir, 1), and the (a, p) the evaluator uses "
+                "at the table's sun angle (the depth function's error)"},
         {"evaluator", "fog/fog_evaluator.h on the packed textures: mappings, slice interpolation, R11G11B10F and the depth "
                       "function (what a game gets)"},
         {"near_camera", fmt::format("depth <= {} m", FormatExact(p.options.near_depth_m))},
         {"horizon", fmt::format("elevation <= {} deg", FormatExact(p.options.horizon_elevation_deg))},
         {"infinite_depth", "x = 1: the LUT against the direct render of the same directions (consistency)"}};
+    Json tables = Json::array();
+    for (size_t s = 0; s < r.tables.size(); ++s) {
+      tables.push_back({{"sun_zenith_deg", r.tables[s].sun_zenith_deg},
+                        {"used_by_the_fit", static_cast<bool>(p.table_in_fit[s])},
+                        {"fog", FitJson(p.table_fit_fog[s], p.options.per_channel)},
+                        {"shadowed", FitJson(p.table_fit_shadowed[s], p.options.per_channel)}});
+    }
     j["fit"] = {{"angle", AngleDefinitionName(p.params.angle)},
+                {"parameters", ParamModeName(p.options.params)},
                 {"fog", FitJson(p.fit_fog, p.options.per_channel)},
-                {"shadowed", FitJson(p.fit_shadowed, p.options.per_channel)}};
+                {"shadowed", FitJson(p.fit_shadowed, p.options.per_channel)},
+                {"per_table", tables}};
+    Json diag = Json::array();
+    for (const FitDiagnostic& d : p.diagnostics) {
+      diag.push_back({{"name", d.name}, {"description", d.description}, {"all", StatsJson(d.all)},
+                      {"near_camera", StatsJson(d.near)}, {"horizon", StatsJson(d.horizon)}});
+    }
+    j["fit_diagnostics"] = diag;
     j["errors"] = {{"fog", {{"fit", ProductJson(p.fog_fit, r)}, {"evaluator", ProductJson(p.fog_eval, r)}}},
                    {"shadowed", {{"fit", ProductJson(p.shadowed_fit, r)}, {"evaluator", ProductJson(p.shadowed_eval, r)}}}};
     j["attenuation"] = {{"rms_abs", {{"R", p.attenuation_rms_abs[0]}, {"G", p.attenuation_rms_abs[1]}, {"B", p.attenuation_rms_abs[2]}}},
                         {"max_abs", {{"R", p.attenuation_max_abs[0]}, {"G", p.attenuation_max_abs[1]}, {"B", p.attenuation_max_abs[2]}}}};
     j["packing"] = {{"fog", PackJson(p.fog)}, {"shadowed", PackJson(p.shadowed)}, {"attenuation", PackJson(p.attenuation)}};
     j["skybake"] = ProvenanceJson(prov);
-    out[P + "_report.json"] = j.dump(2) + "\n";
+    out[P + "_report.json"] = CompactNumberArrays(j.dump(2)) + "\n";
   }
 
   // ---- Residual maps.

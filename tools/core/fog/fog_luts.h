@@ -16,6 +16,7 @@
 #include <array>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,9 +29,29 @@
 
 namespace skybake::fog {
 
+// Where the depth function's parameters live (docs/fog.md, "Per-slice parameters").
+//   kPerSlice  (a, p) per channel are fitted per depth table (sun angle), then, per slice of the fog
+//              LUT, interpolated in the slice's sun zenith angle (ln a and p linear between the
+//              tables' angles, constant beyond the first and the last); the evaluator blends them
+//              between slices as the LUT (fog_evaluator.h);
+//   kGlobal    one (a, p) per channel for every sun angle: the talk's model;
+//   kPerSliceElevation  as kPerSlice, and a also per elevation node of the depth tables (v =
+//              (elevation/90 deg)^(1/2)): k fitted per table and elevation, stored as
+//              a = k / theta^p with the table's p, interpolated as a; the evaluator is linear in v.
+enum class ParamMode { kGlobal, kPerSlice, kPerSliceElevation };
+const char* ParamModeName(ParamMode m);  // "global", "per-slice", "per-slice-elevation"
+std::optional<ParamMode> ParseParamMode(const std::string& name);
+
 struct FogFitOptions {
   AngleDefinition angle = AngleDefinition::kPath;
   bool per_channel = true;            // false: one (a, p) fitted on luminance, used for R, G and B
+  ParamMode params = ParamMode::kPerSliceElevation;  // docs/fog.md, "Where a and p live"
+  // The depth tables (sun zenith angles, deg) the fit uses; empty: all. The errors are measured on
+  // every table, so leaving tables out measures the interpolation between sun angles.
+  std::vector<double> fit_sun_zenith_deg;
+  // The fits use every n-th elevation row of the tables (and the last); the errors are measured
+  // on all rows, so n = 2 measures the interpolation between elevation nodes.
+  int fit_elevation_stride = 1;
   FitOptions fit;
   double night_end_zenith_deg = 108.0;  // lut::SkyLutDecoder's night ramp (the fog's night value is 0)
   double near_depth_m = 1000.0;         // "near the camera": depth <= this (the 1 km)
@@ -51,13 +72,25 @@ struct ProductStats {
   std::vector<ErrorStats> near_per_sun, all_per_sun;  // per depth table
 };
 
+// The fog's fit error (luminance, "fit" as in ProductStats) of other parameter choices on the same
+// render: what per-slice parameters gain over the global pair, and what an azimuth dimension would.
+struct FitDiagnostic {
+  std::string name, description;
+  ErrorStats all, near, horizon;
+};
+
 struct FogProducts {
   std::string sky;
   FogParams params;
   FogFitOptions options;
-  std::array<FitResult, 3> fit_fog, fit_shadowed;  // per channel (luminance fit: three copies)
+  std::array<FitResult, 3> fit_fog, fit_shadowed;  // the global fit, per channel (luminance fit: three copies)
+  // Per depth table (FogRender::tables order): used by the fit, and its own fit (per-slice mode).
+  std::vector<bool> table_in_fit, elevation_in_fit;
+  std::vector<std::array<FitResult, 3>> table_fit_fog, table_fit_shadowed;
+  std::vector<FitDiagnostic> diagnostics;
   lut::PackedTexture fog, shadowed, attenuation;
   lut::SkyRender layout;  // the slices' mappings (for lut::SkyKtx2)
+  gt7::TexelGrid texel_grid = gt7::TexelGrid::kNodes;  // the render's
 
   ProductStats fog_fit, fog_eval, shadowed_fit, shadowed_eval;
   // Attenuation LUT (packed, interpolated) vs the exact sunlight-weighted transmittance at the

@@ -172,7 +172,8 @@ FogRender RenderFog(const Scene& scene, const FogRenderOptions& o, const Progres
   r.time = gt7::TimeMapping::FromName(o.time_mapping, scene.spec.planet->radius_m, scene.spec.planet->top_m, h);
   r.time_mapping_name = o.time_mapping;
   r.slice_zenith_deg = r.time.SliceZenithDeg();
-  const gt7::Gt7SkyMapping mapping(r.lut_width, r.lut_height, r.sphere);
+  r.texel_grid = o.texel_grid;
+  const gt7::Gt7SkyMapping mapping = r.mapping();
   const size_t texels = static_cast<size_t>(r.lut_width) * r.lut_height;
   const size_t n_slices = r.slice_zenith_deg.size();
   r.slice_xyz.assign(n_slices, std::vector<float>(texels * 3, 0.0f));
@@ -322,16 +323,16 @@ void WriteFogRender(const Scene& scene, const FogRenderOptions& o, const FogRend
   for (double a : r.azimuth_deg) az += (az.empty() ? "" : ",") + FormatExact(a);
   for (const FogDepthTable& t : r.tables) sz += (sz.empty() ? "" : ",") + FormatExact(t.sun_zenith_deg);
   prov.parameters = fmt::format(
-      "subcommand: fog\ncut_altitude_m: {}\nobserver_altitude_m: {}\nlut_size: {}x{}\ntime_mapping: {}\n"
+      "subcommand: fog\ncut_altitude_m: {}\nobserver_altitude_m: {}\nlut_size: {}x{}\nlut_texels: {}\ntime_mapping: {}\n"
       "sun_zenith_deg: [{}]\nelevations: {}\nazimuth_deg: [{}]\ndepths: {}\nattenuation_size: {}x{}\n",
-      FormatExact(r.cut_altitude_m), FormatExact(r.observer_altitude_m), r.lut_width, r.lut_height, r.time_mapping_name,
-      sz, r.elevation_deg.size(), az, r.depth_x.size(), r.attenuation_width, r.attenuation_height) +
+      FormatExact(r.cut_altitude_m), FormatExact(r.observer_altitude_m), r.lut_width, r.lut_height,
+      gt7::TexelGridName(r.texel_grid), r.time_mapping_name, sz, r.elevation_deg.size(), az, r.depth_x.size(), r.attenuation_width, r.attenuation_height) +
                     r.method_description + scene.parameters;
   for (const fs::path& f : scene.files_read) prov.AddInput(f);
   (void)o;
 
   std::vector<ExrPart> parts;
-  const gt7::Gt7SkyMapping mapping(r.lut_width, r.lut_height, r.sphere);
+  const gt7::Gt7SkyMapping mapping = r.mapping();
   const size_t texels = static_cast<size_t>(r.lut_width) * r.lut_height;
   for (size_t k = 0; k < r.slice_zenith_deg.size(); ++k) {
     ExrImage img;
@@ -532,7 +533,12 @@ FogRender ReadFogRender(const fs::path& path) {
   if (static_cast<int>(slices.size()) != r.time.slices()) {
     fail(fmt::format("{} fog LUT slices, but the time mapping '{}' has {}", slices.size(), r.time_mapping_name, r.time.slices()));
   }
-  const std::string expect_mapping = gt7::Gt7SkyMapping(r.lut_width, r.lut_height, r.sphere).Describe();
+  // The texel grid is part of the mapping's description (renders before the node grid: centres).
+  const std::string* first_mapping = StringAttr(first, "skybake.mapping");
+  for (gt7::TexelGrid g : {gt7::TexelGrid::kCentres, gt7::TexelGrid::kNodes}) {
+    if (first_mapping && *first_mapping == gt7::Gt7SkyMapping(r.lut_width, r.lut_height, r.sphere, g).Describe()) r.texel_grid = g;
+  }
+  const std::string expect_mapping = r.mapping().Describe();
   const std::vector<double> expect_zenith = r.time.SliceZenithDeg();
   const size_t texels = static_cast<size_t>(r.lut_width) * r.lut_height;
   for (size_t k = 0; k < slices.size(); ++k) {

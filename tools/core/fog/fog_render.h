@@ -43,6 +43,9 @@ struct FogRenderOptions {
   // LUT slices: GT7 sphere mapping W x H, GT7 time mapping name (lut/gt7_mapping.h).
   int lut_width = 32, lut_height = 32;
   std::string time_mapping = "gt7-quadratic";
+  // Texel grid of the slices (lut/gt7_mapping.h): nodes (default) puts a row at the zenith of the
+  // lat-long family (docs/fog.md, "Texel grid"); centres is lut-pack's grid.
+  gt7::TexelGrid texel_grid = gt7::TexelGrid::kNodes;
   // Depth tables.
   std::vector<double> sun_zenith_deg = {30, 60, 80, 88, 92, 96};
   int elevations = 17;   // m
@@ -78,6 +81,7 @@ struct FogRender {
   gt7::TimeMapping time;
   std::string time_mapping_name;
   gt7::SphereMapping sphere;
+  gt7::TexelGrid texel_grid = gt7::TexelGrid::kNodes;
   std::vector<double> slice_zenith_deg;
   std::vector<std::vector<float>> slice_xyz, slice_shadowed_xyz;  // per slice W*H*3
   std::vector<std::vector<float>> slice_y_stderr;                 // per slice W*H (fog)
@@ -92,6 +96,7 @@ struct FogRender {
   std::vector<float> attenuation;
 
   FogGeometry geometry() const { return FogGeometry(planet_radius_m, observer_altitude_m, cut_altitude_m); }
+  gt7::Gt7SkyMapping mapping() const { return gt7::Gt7SkyMapping(lut_width, lut_height, sphere, texel_grid); }
   size_t TableIndex(size_t e, size_t a, size_t j) const { return (e * azimuth_deg.size() + a) * depth_x.size() + j; }
 };
 
