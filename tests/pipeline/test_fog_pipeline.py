@@ -1,12 +1,24 @@
 """The fog-fit stage of the generated pipeline (issue 7), on a temporary copy of the repo, with a
 reduced set: three basis skies (clear, hazed, cloudy2), `orders` at low quality on 7 wavelengths,
-a 4x8 fog LUT on 5 slices (gt7:3+2), an 8x8 attenuation LUT, one depth table (sun 40 deg, 3
-elevations x 2 azimuths x 4 depths), a tiny particle type for every aerosol, no sky references.
+a 4x8 fog LUT on 5 slices (gt7:3+2), an 8x8 attenuation LUT, two depth tables (sun 40 and 85 deg,
+3 elevations x 2 azimuths x 4 depths), a tiny particle type for every aerosol, no sky references.
 
 Checks: a fresh bake runs one fog render and one fit per sky, then has no work; editing hazed.yaml
 re-runs only hazed's render and fit, and clear's and cloudy2's fog products keep their bytes and
-mtimes; missingdeps is clean; an unknown basis sky fails with pipeline.yaml:line.
+mtimes; missingdeps is clean; an unknown basis sky fails with pipeline.yaml:line; and the golden
+check of the fog textures and parameters against tests/fog/golden/.
+
+Golden check (docs/fog.md, "Golden check"), lut-pack's rule (tests/pipeline/test_lut_pipeline.py):
+every R11G11B10F code of the fog, shadowed fog and attenuation textures of the three skies within
+one step of the stored golden's (a float difference between compilers or CPUs that crosses a
+rounding boundary moves a code by one; more is a change of the physics, the mapping or the
+packing), at most 2 % of the codes different at all; sizes and the texel grid equal; the per-slice
+(a, p) within 1e-3 relative (a) and 1e-3 absolute (p): the fit stops at 1e-12 (fog/fog_fit.cpp),
+so only its float32 input can move them, by ~1e-6; the fit's RMS error near the camera within
+0.001 (0.1 point). Update mode: SKYBAKE_UPDATE_GOLDENS=1 rewrites tests/fog/golden/ from this bake
+and says what changed.
 """
+import hashlib
 import json
 import os
 import re
@@ -16,7 +28,9 @@ import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "cli"))
 from skytest import SRC, PipelineTestCase, run, tool  # noqa: E402
-from test_lut_pipeline import TINY_PARTICLE, edges_run  # noqa: E402
+from test_lut_pipeline import TINY_PARTICLE, codes, edges_run, ktx2_texels  # noqa: E402
+
+GOLDEN = os.path.join(SRC, "tests", "fog", "golden")
 
 PIPELINE = """outputs: outputs
 altitude_step_m: 100
@@ -35,11 +49,12 @@ fog:
   time_mapping: "gt7:3+2"
   lut_size: 4x8
   attenuation_size: 8x8
-  depth_tables: {sun_zenith_deg: [40], elevations: 3, azimuths_deg: [0, 180], depths: 4}
+  depth_tables: {sun_zenith_deg: [40, 85], elevations: 3, azimuths_deg: [0, 180], depths: 4}
   skies: [clear, hazed, cloudy2]
 """
 
 SKIES = ("clear", "hazed", "cloudy2")
+TEXTURES = ["fog_%s%s.ktx2" % (sky, kind) for sky in SKIES for kind in ("", "_shadowed", "_attenuation")]
 
 
 class FogPipelineTest(PipelineTestCase):
@@ -67,7 +82,8 @@ class FogPipelineTest(PipelineTestCase):
             self.assertEqual(ran.count("sky-render %s/fog.exr" % atm), 1, ran)
             self.assertEqual(ran.count("fog-fit fog/fog_%s.json" % atm), 1, ran)
             for suffix in (".json", ".ktx2", "_array.ktx2", ".dds", "_shadowed.ktx2", "_shadowed.dds",
-                           "_attenuation.ktx2", "_attenuation.dds", ".exr", "_report.json", "_residuals.png"):
+                           "_attenuation.ktx2", "_attenuation.dds", "_params.ktx2", ".exr", "_report.json",
+                           "_residuals.png"):
                 self.assertTrue(os.path.isfile(os.path.join(self.out, "fog", "fog_" + atm + suffix)), atm + suffix)
             with open(os.path.join(self.out, "fog", "fog_%s_report.json" % atm)) as f:
                 report = json.load(f)
@@ -88,6 +104,81 @@ class FogPipelineTest(PipelineTestCase):
         for f in ("fog/fog_hazed.ktx2", "fog/fog_hazed.json", "fog/fog_hazed_report.json", "hazed/fog.exr"):
             self.assertNotEqual(before[f], after[f], f)
         self.assertIn("no work to do", self.ninja("-n").stdout)
+
+    def test_golden_reduced_bake(self):
+        r = run([tool("skybake"), "bake", "pipeline.yaml"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+        fog = os.path.join(self.out, "fog")
+        summary = {"textures": {}, "parameters": {}}
+        for name in TEXTURES:
+            w, h, d, layers, level = ktx2_texels(os.path.join(fog, name))
+            summary["textures"][name] = {"size": [w, h, d, layers], "texels_sha256": hashlib.sha256(level).hexdigest()}
+        for sky in SKIES:
+            with open(os.path.join(fog, "fog_%s.json" % sky)) as f:
+                model = json.load(f)["model"]
+            with open(os.path.join(fog, "fog_%s_report.json" % sky)) as f:
+                report = json.load(f)
+            ps = model["per_slice"]
+            summary["parameters"][sky] = {
+                "parameters": model["parameters"],
+                "fog_a": ps["fog"]["a"], "fog_p": ps["fog"]["p"],
+                "shadowed_a": ps["shadowed"]["a"], "shadowed_p": ps["shadowed"]["p"],
+                "fit_near_camera_rms": report["errors"]["fog"]["fit"]["near_camera"]["rms"]}
+        with open(os.path.join(fog, "fog_clear.ktx2"), "rb") as f:
+            summary["texel_grid"] = "nodes" if b"skybake.texel_grid\x00nodes\x00" in f.read() else "centres"
+        if os.environ.get("SKYBAKE_UPDATE_GOLDENS") == "1":
+            self.update_goldens(fog, summary)
+            return
+        manifest = os.path.join(GOLDEN, "manifest.json")
+        self.assertTrue(os.path.isfile(manifest), "no goldens: run with SKYBAKE_UPDATE_GOLDENS=1")
+        with open(manifest) as f:
+            golden = json.load(f)
+        self.assertEqual(summary["texel_grid"], golden["texel_grid"])
+        lines = []
+        for name in TEXTURES:
+            self.assertEqual(summary["textures"][name]["size"], golden["textures"][name]["size"], name)
+            ours = codes(ktx2_texels(os.path.join(fog, name))[4])
+            with open(os.path.join(GOLDEN, name + ".texels"), "rb") as f:
+                theirs = codes(f.read())
+            self.assertEqual(len(ours), len(theirs), name)
+            worst = max(abs(x - y) for t, g in zip(ours, theirs) for x, y in zip(t, g))
+            differing = sum(1 for t, g in zip(ours, theirs) for x, y in zip(t, g) if x != y)
+            lines.append("%s: %d of %d codes differ (worst by %d)" % (name, differing, 3 * len(ours), worst))
+            self.assertLessEqual(worst, 1, "%s: a code moved by %d steps (SKYBAKE_UPDATE_GOLDENS=1 after a deliberate "
+                                           "change)" % (name, worst))
+            self.assertLessEqual(differing / (3.0 * len(ours)), 0.02, name)
+        for sky in SKIES:
+            ours, theirs = summary["parameters"][sky], golden["parameters"][sky]
+            self.assertEqual(ours["parameters"], theirs["parameters"], sky)
+            for key in ("fog_a", "fog_p", "shadowed_a", "shadowed_p"):
+                self.assertEqual(len(ours[key]), len(theirs[key]), (sky, key))
+                for row_o, row_t in zip(ours[key], theirs[key]):
+                    for a, b in zip(row_o, row_t):
+                        if key.endswith("_a"):
+                            self.assertLessEqual(abs(a / b - 1), 1e-3, (sky, key, a, b))
+                        else:
+                            self.assertLessEqual(abs(a - b), 1e-3, (sky, key, a, b))
+            self.assertLessEqual(abs(ours["fit_near_camera_rms"] - theirs["fit_near_camera_rms"]), 1e-3, sky)
+        print("fog golden check:\n  " + "\n  ".join(lines))
+
+    def update_goldens(self, fog, summary):
+        os.makedirs(GOLDEN, exist_ok=True)
+        old = {}
+        manifest = os.path.join(GOLDEN, "manifest.json")
+        if os.path.isfile(manifest):
+            with open(manifest) as f:
+                old = json.load(f)
+        for name in TEXTURES:
+            with open(os.path.join(GOLDEN, name + ".texels"), "wb") as f:
+                f.write(ktx2_texels(os.path.join(fog, name))[4])
+            state = "unchanged" if old.get("textures", {}).get(name) == summary["textures"][name] else "UPDATED"
+            print("golden %s: %s" % (name, state))
+        for sky in SKIES:
+            state = "unchanged" if old.get("parameters", {}).get(sky) == summary["parameters"][sky] else "UPDATED"
+            print("golden parameters %s: %s" % (sky, state))
+        with open(manifest, "w") as f:
+            json.dump(summary, f, indent=2, sort_keys=True)
+            f.write("\n")
 
     def test_unknown_basis_sky_is_an_error_at_its_line(self):
         self.edit("pipeline.yaml", "skies: [clear, hazed, cloudy2]", "skies: [clear, hazed, cloudy9]")
