@@ -123,6 +123,9 @@ class FogPipelineTest(PipelineTestCase):
                 "parameters": model["parameters"],
                 "fog_a": ps["fog"]["a"], "fog_p": ps["fog"]["p"],
                 "shadowed_a": ps["shadowed"]["a"], "shadowed_p": ps["shadowed"]["p"],
+                # a at the elevation nodes, flattened per slice (nodes x R, G, B)
+                "fog_a_nodes": [[c for node in row for c in node] for row in ps["elevation_nodes"]["fog"]["a"]],
+                "shadowed_a_nodes": [[c for node in row for c in node] for row in ps["elevation_nodes"]["shadowed"]["a"]],
                 "fit_near_camera_rms": report["errors"]["fog"]["fit"]["near_camera"]["rms"]}
         with open(os.path.join(fog, "fog_clear.ktx2"), "rb") as f:
             summary["texel_grid"] = "nodes" if b"skybake.texel_grid\x00nodes\x00" in f.read() else "centres"
@@ -150,11 +153,11 @@ class FogPipelineTest(PipelineTestCase):
         for sky in SKIES:
             ours, theirs = summary["parameters"][sky], golden["parameters"][sky]
             self.assertEqual(ours["parameters"], theirs["parameters"], sky)
-            for key in ("fog_a", "fog_p", "shadowed_a", "shadowed_p"):
+            for key in ("fog_a", "fog_p", "shadowed_a", "shadowed_p", "fog_a_nodes", "shadowed_a_nodes"):
                 self.assertEqual(len(ours[key]), len(theirs[key]), (sky, key))
                 for row_o, row_t in zip(ours[key], theirs[key]):
                     for a, b in zip(row_o, row_t):
-                        if key.endswith("_a"):
+                        if key.endswith("_a") or key.endswith("_nodes"):
                             self.assertLessEqual(abs(a / b - 1), 1e-3, (sky, key, a, b))
                         else:
                             self.assertLessEqual(abs(a - b), 1e-3, (sky, key, a, b))
