@@ -5,8 +5,9 @@
 //           [--fit-elevation-stride N]
 //           [--name SKY] [--ocio-config config.ocio] [--depfile OUT/fog_<sky>.json.d]
 //       FOG.exr: sky-render fog (one basis sky). Fits a and p of
-//       Fog = LUT(dir) (1 - exp(-a theta^p x)) / (1 - exp(-a theta^p)) for the fog and the shadowed fog,
-//       packs the fog, shadowed fog and attenuation LUTs (R11G11B10F KTX2 3D + 2D array, DDS, EXR) and
+//       Fog = LUT(dir) (1 - exp(-a theta^p x)) / (1 - exp(-a theta^p)) for the fog and the shadowed fog
+//       (per slice and elevation, per slice or global: --params), packs the fog, shadowed fog and
+//       attenuation LUTs (R11G11B10F KTX2 3D + 2D array, DDS, EXR) and the parameter texture, and
 //       writes the parameters (-o), the residual report and residual maps beside it.
 //   fog-fit eval fog_<sky>.json --points in.csv -o out.csv
 //       the reference evaluator: fog and transmittance for explicit directions, depths and sun angles.
@@ -45,8 +46,9 @@ bool IsName(const std::string& s) {
 int main(int argc, char** argv) {
   ToolCli cli("fog-fit",
               "GT7 global fog from a reference fog render (sky-render fog): fits the depth function\n"
-              "Fog = LUT(dir) (1 - exp(-a theta^p x)) / (1 - exp(-a theta^p)), packs the fog, shadowed fog and\n"
-              "attenuation LUTs and reports the model's error; `eval` runs the reference evaluator. See docs/fog.md.");
+              "Fog = LUT(dir) (1 - exp(-a theta^p x)) / (1 - exp(-a theta^p)) (a, p per fog LUT slice, a also per\n"
+              "elevation by default), packs the fog, shadowed fog, attenuation and parameter textures and reports\n"
+              "the model's error; `eval` runs the reference evaluator. See docs/fog.md.");
   cli.app().require_subcommand(1);
   cli.app().fallthrough();
   std::string output, depfile, ocio_config;
