@@ -408,7 +408,6 @@ TEST(FogRender, PerSliceElevationParametersFollowTheNodes) {
   const FogParams& p = f.products.params;
   ASSERT_EQ(p.node_v.size(), f.render.elevation_deg.size());
   ASSERT_EQ(p.slices.size(), f.render.slice_zenith_deg.size());
-  const FogGeometry geo = f.render.geometry();
   const double ts = f.render.slice_zenith_deg[1] * kDeg;  // table 1's sun angle: slice 1's row is its fit
   for (size_t j = 0; j < p.node_v.size(); ++j) {
     const double mu = std::sin(f.render.elevation_deg[j] * kDeg);
@@ -427,7 +426,6 @@ TEST(FogRender, PerSliceElevationParametersFollowTheNodes) {
   }
   // Below the horizon: the horizon's node.
   EXPECT_EQ(f.eval->ParamsAt(ts, -0.3).a, f.eval->ParamsAt(ts, 0.0).a);
-  (void)geo;
   // Over the tables, the elevation nodes take most of the depth function's error away (fit near
   // the camera below the per-slice model's; measured below in ModelErrorAgainstReference).
   const FitDiagnostic& global = f.products.diagnostics[0];

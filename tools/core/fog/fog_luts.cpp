@@ -261,13 +261,7 @@ FogProducts BuildFogProducts(const FogRender& render, const std::string& sky, co
     }
     std::vector<std::vector<std::array<double, 3>>> a_se(n_tab), a_se_sh(n_tab);
     if (o.params == ParamMode::kPerSliceElevation) {
-      for (double v_e : [&] {
-             std::vector<double> v;
-             for (size_t e : nodes_e) v.push_back(AttenuationV(mu[e]));
-             return v;
-           }()) {
-        par.node_v.push_back(v_e);
-      }
+      for (size_t e : nodes_e) par.node_v.push_back(AttenuationV(mu[e]));
       for (size_t s = 0; s < n_tab; ++s) {
         if (!out.table_in_fit[s]) continue;
         for (int prod = 0; prod < 2; ++prod) {
