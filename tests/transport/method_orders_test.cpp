@@ -73,14 +73,18 @@ TEST(MethodOrders, FirstOrderIsTheSingleScattering) {
 
 // All orders against the path tracer (all orders; 1.5 % standard error per direction, 2 % at
 // sun 90 deg), clear (aerosol tau_550 0.1) and hazed (0.5), on the 21-wavelength test grid,
-// medium tables. Measured (RMS / max over the 10 directions, noise included):
-//   clear: sun 30: 1.3 / 2.4 %, 70: 1.9 / 3.7 %, 85: 1.9 / 3.8 %, 90: 2.6 / 4.3 %
-//   hazed: sun 30: 5.9 / 8.3 %, 70: 6.3 / 14.1 %, 85: 3.3 / 7.3 %, 90: 2.9 / 4.9 %
-// (radius nodes following the optical depth; with altitude-only nodes the hazed rows were
-// 4.1 / 7.1, 6.6 / 14.4, 6.4 / 11.0, 5.7 / 9.3 %.)
+// medium tables. Measured (RMS / max over the 10 directions, noise included), 2026-11-23 (5 deg
+// truncation, exponential step integration, view nodes in angle, tail per settled element):
+//   clear: sun 30: 1.6 / 3.1 %, 70: 2.2 / 4.0 %, 85: 1.4 / 2.6 %, 90: 3.4 / 5.4 %
+//   hazed: sun 30: 1.6 / 2.8 %, 70: 2.4 / 4.2 %, 85: 2.9 / 5.5 %, 90: 3.4 / 7.0 %
+// (before, with a 15 deg truncation and the midpoint rule: clear 1.3 / 2.4, 1.9 / 3.7,
+// 1.9 / 3.8, 2.6 / 4.3 %; hazed 5.9 / 8.3, 6.3 / 14.1, 3.3 / 7.3, 2.9 / 4.9 %). With this
+// reference's noise (1.5 %) the clear rows are mostly noise: against 1 % references on 35
+// directions and 48 wavelengths the noise-corrected RMS is 0.5 / 1.0 / 1.2 / 2.1 % (clear) and
+// 0.9 / 2.9 / 2.4 / 1.5 % (hazed) at sun 30 / 70 / 85 / 90 deg (docs/sky-methods.md "orders").
 // The bounds are those figures plus the reference's noise. The issue's target (RMS 0.5 %, max
-// 2 %) is NOT met; the hazed error is already in the second order and depends on the forward-
-// peak truncation (docs/sky-methods.md "orders": measured with truncation 5/8/15/30 deg).
+// 2 %) is NOT met; what remains is the forward peak (truncation cone and kernel resolution:
+// docs/sky-methods.md "orders").
 struct OrdersCase {
   double sza, target, max_rms, max_abs;
 };
@@ -88,7 +92,7 @@ struct OrdersCase {
 TEST(MethodOrders, AgainstThePathTracerFromDaylightToSunset) {
   const std::pair<const char*, std::vector<OrdersCase>> sets[] = {
       {"clear", {{30.0, 0.015, 0.03, 0.05}, {70.0, 0.015, 0.03, 0.06}, {85.0, 0.015, 0.03, 0.07}, {90.0, 0.02, 0.045, 0.08}}},
-      {"hazed", {{30.0, 0.015, 0.075, 0.11}, {70.0, 0.015, 0.09, 0.18}, {85.0, 0.015, 0.06, 0.11}, {90.0, 0.02, 0.06, 0.09}}}};
+      {"hazed", {{30.0, 0.015, 0.03, 0.05}, {70.0, 0.015, 0.04, 0.07}, {85.0, 0.015, 0.045, 0.08}, {90.0, 0.02, 0.05, 0.09}}}};
   for (const auto& [atm, cases] : sets) {
     const TestScene sc = LoadTestScene(atm);
     SkyMethodOptions o;
@@ -166,13 +170,15 @@ TEST(MethodOrders, OrdersConvergeAndTheTailIsAccurate) {
 
 // A thin, optically thick, conservative layer - a 2 km water-cloud-like tent of optical depth 8
 // at 3.5-5.5 km, Henyey-Greenstein g = 0.8, over a ground of albedo 0.3 - where the successive
-// orders converge slowly (ratio ~0.7 per order) and the sources change fast with altitude. Before
-// the radius nodes followed the optical depth and the sources were stored per unit scattering
-// coefficient, the orders diverged here (ratio 1.29 per order; the cloudy4 sky at 4e6 cd/m^2).
-// They converge now, but to too little light: measured -34, -47, -53, -40 % against the path
-// tracer (2 %) at the four directions (isotropic scattering: -77 to -81 %; 120 ray steps halve
-// it). This is a known defect of `orders` in thick layers (docs/sky-methods.md "orders", "Thick
-// cloud layers"); the bound guards the convergence and the measured error, not the goal.
+// orders converge slowly (the ratio of successive orders creeps up to ~0.93) and the sources
+// change fast with altitude. History of this case against the path tracer (1 %) at the four
+// directions: the orders diverged (ratio 1.29) before the radius nodes followed the optical
+// depth; then -34, -47, -53, -40 % (isotropic scattering -77 to -81 %), because a table ray's
+// midpoint rule lost everything of a step of optical depth ~45 along the inside of the layer;
+// with the exponential step integration, view nodes in angle and the 5 deg truncation
+// (2026-11-23): +1.6, -7.4, -8.4, -11.4 % (isotropic, converged: +5.0, -2.0, -3.3, -5.3 %).
+// `medium` reaches its 40 orders here and ends with the geometric tail. The remaining error is
+// the view resolution (docs/sky-methods.md "Thick cloud layers").
 TEST(MethodOrders, ThickCloudLayerConvergesWithinItsMeasuredError) {
   const double R = 6371e3;
   AtmosphereModel m;
@@ -200,7 +206,7 @@ TEST(MethodOrders, ThickCloudLayerConvergesWithinItsMeasuredError) {
   std::unique_ptr<SkyMethod> orders = MakeSkyMethod("orders", m, o, {});
   const std::string desc = orders->Describe();
   std::printf("%s", desc.c_str());
-  EXPECT_EQ(desc.find("orders_computed: 40"), std::string::npos) << "did not converge";
+  EXPECT_NE(desc.find("tail_extrapolated: true"), std::string::npos) << "no tail";
   std::vector<double> L;
   orders->Radiance(1.0, 30.0 * kDeg, dirs, &L);
   PathTracerSettings ps;
@@ -218,6 +224,6 @@ TEST(MethodOrders, ThickCloudLayerConvergesWithinItsMeasuredError) {
     std::printf("thick layer, dir %zu: orders %.5g path %.5g +- %.1f %%: %+.1f %%\n", d, y, ref[d].xyz[1],
                 100.0 * ref[d].xyz_stderr[1] / ref[d].xyz[1], 100.0 * e);
     EXPECT_TRUE(std::isfinite(y) && y > 0.0);
-    EXPECT_LT(std::abs(e), 0.6) << "dir " << d;  // measured 0.34-0.53
+    EXPECT_LT(std::abs(e), 0.16) << "dir " << d;  // measured 0.016-0.114 (path 2 %)
   }
 }
