@@ -195,6 +195,18 @@ class OrdersMethod : public SkyMethod {
     double tk[2] = {0, 0};     // weight of k1
   };
   RadialView RadialViewAt(double r, double mu) const;
+  // The sun-angle and azimuth part of an interpolation (fixed for a table-ray step across all
+  // orders, so computed once).
+  struct SunAzimuth {
+    uint16_t si = 0;  // lower sun node; kNoSun beyond the last node (no light)
+    uint16_t q0 = 0;  // lower azimuth node
+    float ts = 0.0f;  // weight of si + 1
+    float tq = 0.0f;  // weight of q0 + 1
+  };
+  static constexpr uint16_t kNoSun = 0xFFFF;
+  SunAzimuth SunAzimuthAt(double theta_s, double cos_phi) const;
+  void Interpolate(const std::vector<float>& tab, const RadialView& rv, const SunAzimuth& sa, double weight,
+                   float* acc) const;
   // Interpolates table `tab` (cells x nw) at a point, accumulating weight * value into acc.
   void Interpolate(const std::vector<float>& tab, double r, double theta_s, double mu, double cos_phi, double weight,
                    float* acc) const {
@@ -545,15 +557,35 @@ OrdersMethod::RadialView OrdersMethod::RadialViewAt(double r, double mu) const {
   return v;
 }
 
-void OrdersMethod::Interpolate(const std::vector<float>& tab, const RadialView& rv, double theta_s, double cos_phi,
-                               double weight, float* acc) const {
-  if (theta_s > sun_theta_rad_.back()) return;  // beyond the last sun node: no light
+OrdersMethod::SunAzimuth OrdersMethod::SunAzimuthAt(double theta_s, double cos_phi) const {
+  SunAzimuth sa;
+  if (theta_s > sun_theta_rad_.back()) {
+    sa.si = kNoSun;
+    return sa;
+  }
   const Lerp ls = Locate(sun_theta_rad_, theta_s);
   const double phi = std::acos(std::clamp(cos_phi, -1.0, 1.0));
   double fq = phi / kPi * s_.nphi - 0.5;
   fq = std::clamp(fq, 0.0, static_cast<double>(s_.nphi - 1));
   const size_t q0 = std::min(static_cast<size_t>(fq), static_cast<size_t>(s_.nphi - 2));
-  const double tq = fq - static_cast<double>(q0);
+  sa.si = static_cast<uint16_t>(ls.i);
+  sa.q0 = static_cast<uint16_t>(q0);
+  sa.ts = static_cast<float>(ls.t);
+  sa.tq = static_cast<float>(fq - static_cast<double>(q0));
+  return sa;
+}
+
+void OrdersMethod::Interpolate(const std::vector<float>& tab, const RadialView& rv, double theta_s, double cos_phi,
+                               double weight, float* acc) const {
+  Interpolate(tab, rv, SunAzimuthAt(theta_s, cos_phi), weight, acc);
+}
+
+void OrdersMethod::Interpolate(const std::vector<float>& tab, const RadialView& rv, const SunAzimuth& sa, double weight,
+                               float* acc) const {
+  if (sa.si == kNoSun) return;  // beyond the last sun node: no light
+  const Lerp ls{sa.si, sa.ts};
+  const size_t q0 = sa.q0;
+  const double tq = sa.tq;
   for (int dr = 0; dr < 2; ++dr) {
     const size_t ri = rv.ri + static_cast<size_t>(dr);
     const double wr = rv.wr[dr];
@@ -855,6 +887,29 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
   };
   // The transport step: L = int T* sigma_s* J dt along every table ray + the ground's
   // reflection of the irradiance of Lin (the radiance the sources J came from).
+  // The sun/azimuth interpolation position of every (cell, step), shared by all orders (saves
+  // two acos and a node search per lookup); skipped if it would take more than 768 MiB.
+  std::vector<SunAzimuth> sun_az;
+  if (cells * nt * sizeof(SunAzimuth) <= (size_t{768} << 20)) {
+    sun_az.resize(cells * nt);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nr * ns_ * nu_, 4), [&](const tbb::blocked_range<size_t>& rg) {
+      for (size_t idx = rg.begin(); idx != rg.end(); ++idx) {
+        const size_t ri = idx / (ns_ * nu_), si = (idx / nu_) % ns_, k = idx % nu_;
+        const Family& f = fam[ri * nu_ + k];
+        const double r = radius_[ri], ts = sun_theta_rad_[si];
+        for (size_t q = 0; q < nphi; ++q) {
+          double mu, nu;
+          cell_geometry(ri, si, k, q, &mu, &nu);
+          for (size_t m = 0; m < f.t.size(); ++m) {
+            const double mus = std::clamp((r * std::cos(ts) + f.t[m] * nu) / f.r[m], -1.0, 1.0);
+            const double mu2 = f.mu[m];
+            const double denom = std::sqrt(std::max(1e-12, (1.0 - mu2 * mu2) * (1.0 - mus * mus)));
+            sun_az[Cell(ri, si, k, q) * nt + m] = SunAzimuthAt(std::acos(mus), (nu - mu2 * mus) / denom);
+          }
+        }
+      }
+    });
+  }
   auto transport = [&](const std::vector<float>& Jin, const std::vector<float>& Lin, std::vector<float>* Lout) {
     ground_irradiance(Lin, &E);
     // L_n = int T* J_n dt + ground reflection of E_{n-1}.
@@ -868,13 +923,17 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
           double mu, nu;
           cell_geometry(ri, si, k, q, &mu, &nu);
           std::fill(acc.begin(), acc.end(), 0.0f);
+          const SunAzimuth* sa = sun_az.empty() ? nullptr : &sun_az[Cell(ri, si, k, q) * nt];
           for (size_t m = 0; m < f.t.size(); ++m) {
-            const double mus = std::clamp((r * std::cos(ts) + f.t[m] * nu) / f.r[m], -1.0, 1.0);
-            const double mu2 = f.mu[m];
-            const double denom = std::sqrt(std::max(1e-12, (1.0 - mu2 * mu2) * (1.0 - mus * mus)));
-            const double cphi = (nu - mu2 * mus) / denom;
             std::fill(jv.begin(), jv.end(), 0.0f);
-            Interpolate(Jin, f.rv[m], std::acos(mus), cphi, 1.0, jv.data());
+            if (sa != nullptr) {
+              Interpolate(Jin, f.rv[m], sa[m], 1.0, jv.data());
+            } else {
+              const double mus = std::clamp((r * std::cos(ts) + f.t[m] * nu) / f.r[m], -1.0, 1.0);
+              const double mu2 = f.mu[m];
+              const double denom = std::sqrt(std::max(1e-12, (1.0 - mu2 * mu2) * (1.0 - mus * mus)));
+              Interpolate(Jin, f.rv[m], SunAzimuthAt(std::acos(mus), (nu - mu2 * mus) / denom), 1.0, jv.data());
+            }
             for (size_t w = 0; w < nw_; ++w) acc[w] += f.wt[m * nw_ + w] * f.ssc[m * nw_ + w] * jv[w];
           }
           if (f.ground) {
