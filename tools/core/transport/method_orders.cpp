@@ -205,14 +205,8 @@ class OrdersMethod : public SkyMethod {
   };
   static constexpr uint16_t kNoSun = 0xFFFF;
   SunAzimuth SunAzimuthAt(double theta_s, double cos_phi) const;
-  void Interpolate(const std::vector<float>& tab, const RadialView& rv, const SunAzimuth& sa, double weight,
-                   float* acc) const;
   // Interpolates table `tab` (cells x nw) at a point, accumulating weight * value into acc.
-  void Interpolate(const std::vector<float>& tab, double r, double theta_s, double mu, double cos_phi, double weight,
-                   float* acc) const {
-    Interpolate(tab, RadialViewAt(r, mu), theta_s, cos_phi, weight, acc);
-  }
-  void Interpolate(const std::vector<float>& tab, const RadialView& rv, double theta_s, double cos_phi, double weight,
+  void Interpolate(const std::vector<float>& tab, const RadialView& rv, const SunAzimuth& sa, double weight,
                    float* acc) const;
 
   const AtmosphereModel& m_;
@@ -573,11 +567,6 @@ OrdersMethod::SunAzimuth OrdersMethod::SunAzimuthAt(double theta_s, double cos_p
   sa.ts = static_cast<float>(ls.t);
   sa.tq = static_cast<float>(fq - static_cast<double>(q0));
   return sa;
-}
-
-void OrdersMethod::Interpolate(const std::vector<float>& tab, const RadialView& rv, double theta_s, double cos_phi,
-                               double weight, float* acc) const {
-  Interpolate(tab, rv, SunAzimuthAt(theta_s, cos_phi), weight, acc);
 }
 
 void OrdersMethod::Interpolate(const std::vector<float>& tab, const RadialView& rv, const SunAzimuth& sa, double weight,
@@ -1024,7 +1013,7 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
   const size_t nd = nu_ * static_cast<size_t>(s_.nphi);
   // Log-linear interpolation of the MS table in the sun angle (exact for exponential twilight decay).
   const Lerp ls = Locate(sun_theta_rad_, ts);
-  std::vector<float> tsun(nw_), ssc(nw_), st(nw_), acc(nw_), ms0(nw_), ms1(nw_), pc(nc_ * nw_), jv(nw_), sst(nw_);
+  std::vector<float> tsun(nw_), ssc(nw_), st(nw_), acc(nw_), ms0(nw_), ms1(nw_), pc(nc_ * nw_), jv(nw_), jv1(nw_), sst(nw_);
   std::vector<double> tau(nw_), tau_star(nw_), seg_ms(nw_);
   for (size_t d = 0; d < dirs.size(); ++d) {
     const double mu = std::clamp(dirs[d][2], -1.0, 1.0);
@@ -1105,8 +1094,23 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
             const double mu2 = std::clamp((r * mu + t) / rr, -1.0, 1.0);
             const double denom = std::sqrt(std::max(1e-12, (1.0 - mu2 * mu2) * (1.0 - mus_c * mus_c)));
             const double cphi2 = std::clamp((nu - mu2 * mus_c) / denom, -1.0, 1.0);
+            // Log-linear in the sun angle, as the sky's own multiple scattering below: between
+            // twilight nodes 1 deg apart the sources fall ~e-fold, and linear interpolation put
+            // the fog between nodes ~10 % above the nodes' (docs/fog.md, "Limits").
+            const SunAzimuth sa = SunAzimuthAt(std::acos(mus_c), cphi2);
             std::fill(jv.begin(), jv.end(), 0.0f);
-            Interpolate(jms_, rr, std::acos(mus_c), mu2, cphi2, 1.0, jv.data());
+            if (sa.si != kNoSun) {
+              const RadialView rv = RadialViewAt(rr, mu2);
+              std::fill(jv1.begin(), jv1.end(), 0.0f);
+              Interpolate(jms_, rv, SunAzimuth{sa.si, sa.q0, 0.0f, sa.tq}, 1.0, jv.data());
+              if (sa.ts > 0.0f) {
+                Interpolate(jms_, rv, SunAzimuth{static_cast<uint16_t>(sa.si + 1), sa.q0, 0.0f, sa.tq}, 1.0, jv1.data());
+                for (size_t w = 0; w < nw_; ++w) {
+                  const float a = jv[w], b = jv1[w];
+                  jv[w] = a > 0.0f && b > 0.0f ? a * std::pow(b / a, sa.ts) : a + (b - a) * sa.ts;
+                }
+              }
+            }
             std::fill(sst.begin(), sst.end(), 0.0f);
             for (size_t c = 0; c < nc_; ++c) {
               SigmaS(c, rr - R, true, st.data());
