@@ -755,6 +755,17 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
     const float a = phase_star_[(c * kPhaseGrid + gi) * nw_ + w], b = phase_star_[(c * kPhaseGrid + gi + 1) * nw_ + w];
     return a + (b - a) * t;
   };
+  // The sun/azimuth interpolation position of every (cell, step), shared by all orders (saves
+  // two acos and a node search per lookup and order; order 1 fills it); computed per lookup
+  // instead if it would take more than 768 MiB.
+  std::vector<SunAzimuth> sun_az;
+  if (cells * nt * sizeof(SunAzimuth) <= (size_t{768} << 20)) sun_az.resize(cells * nt);
+  auto step_sun_azimuth = [&](const Family& f, size_t m, double r, double ts, double nu) {
+    const double mus = std::clamp((r * std::cos(ts) + f.t[m] * nu) / f.r[m], -1.0, 1.0);
+    const double mu2 = f.mu[m];
+    const double denom = std::sqrt(std::max(1e-12, (1.0 - mu2 * mu2) * (1.0 - mus * mus)));
+    return SunAzimuthAt(std::acos(mus), (nu - mu2 * mus) / denom);
+  };
   ReportProgress(progress, "orders: order 1", 0.0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nr * ns_ * nu_, 4), [&](const tbb::blocked_range<size_t>& rg) {
     std::vector<float> tsun(nw_), ssc(nw_), src(nw_), acc(nw_), pc(nc_ * nw_), eg(nw_);
@@ -778,6 +789,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
             for (size_t w = 0; w < nw_; ++w) src[w] += ssc[w] * pc[c * nw_ + w];
           }
           for (size_t w = 0; w < nw_; ++w) acc[w] += f.wt[m * nw_ + w] * src[w] * tsun[w] * static_cast<float>(sun_e_[w]);
+          if (!sun_az.empty()) sun_az[Cell(ri, si, k, q) * nt + m] = step_sun_azimuth(f, m, r, ts, nu);
         }
         if (f.ground) {
           const double mus_g = (r * std::cos(ts) + f.d * nu) / R;
@@ -876,29 +888,6 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
   };
   // The transport step: L = int T* sigma_s* J dt along every table ray + the ground's
   // reflection of the irradiance of Lin (the radiance the sources J came from).
-  // The sun/azimuth interpolation position of every (cell, step), shared by all orders (saves
-  // two acos and a node search per lookup); skipped if it would take more than 768 MiB.
-  std::vector<SunAzimuth> sun_az;
-  if (cells * nt * sizeof(SunAzimuth) <= (size_t{768} << 20)) {
-    sun_az.resize(cells * nt);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, nr * ns_ * nu_, 4), [&](const tbb::blocked_range<size_t>& rg) {
-      for (size_t idx = rg.begin(); idx != rg.end(); ++idx) {
-        const size_t ri = idx / (ns_ * nu_), si = (idx / nu_) % ns_, k = idx % nu_;
-        const Family& f = fam[ri * nu_ + k];
-        const double r = radius_[ri], ts = sun_theta_rad_[si];
-        for (size_t q = 0; q < nphi; ++q) {
-          double mu, nu;
-          cell_geometry(ri, si, k, q, &mu, &nu);
-          for (size_t m = 0; m < f.t.size(); ++m) {
-            const double mus = std::clamp((r * std::cos(ts) + f.t[m] * nu) / f.r[m], -1.0, 1.0);
-            const double mu2 = f.mu[m];
-            const double denom = std::sqrt(std::max(1e-12, (1.0 - mu2 * mu2) * (1.0 - mus * mus)));
-            sun_az[Cell(ri, si, k, q) * nt + m] = SunAzimuthAt(std::acos(mus), (nu - mu2 * mus) / denom);
-          }
-        }
-      }
-    });
-  }
   auto transport = [&](const std::vector<float>& Jin, const std::vector<float>& Lin, std::vector<float>* Lout) {
     ground_irradiance(Lin, &E);
     // L_n = int T* J_n dt + ground reflection of E_{n-1}.
@@ -915,14 +904,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
           const SunAzimuth* sa = sun_az.empty() ? nullptr : &sun_az[Cell(ri, si, k, q) * nt];
           for (size_t m = 0; m < f.t.size(); ++m) {
             std::fill(jv.begin(), jv.end(), 0.0f);
-            if (sa != nullptr) {
-              Interpolate(Jin, f.rv[m], sa[m], 1.0, jv.data());
-            } else {
-              const double mus = std::clamp((r * std::cos(ts) + f.t[m] * nu) / f.r[m], -1.0, 1.0);
-              const double mu2 = f.mu[m];
-              const double denom = std::sqrt(std::max(1e-12, (1.0 - mu2 * mu2) * (1.0 - mus * mus)));
-              Interpolate(Jin, f.rv[m], SunAzimuthAt(std::acos(mus), (nu - mu2 * mus) / denom), 1.0, jv.data());
-            }
+            Interpolate(Jin, f.rv[m], sa != nullptr ? sa[m] : step_sun_azimuth(f, m, r, ts, nu), 1.0, jv.data());
             for (size_t w = 0; w < nw_; ++w) acc[w] += f.wt[m * nw_ + w] * f.ssc[m * nw_ + w] * jv[w];
           }
           if (f.ground) {
