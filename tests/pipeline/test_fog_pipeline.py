@@ -28,7 +28,8 @@ import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "cli"))
 from skytest import SRC, PipelineTestCase, run, tool  # noqa: E402
-from test_lut_pipeline import TINY_PARTICLE, check_codes, edges_run, ktx2_texels  # noqa: E402
+from test_lut_pipeline import (TINY_PARTICLE, check_codes, edges_run, ktx2_texels,  # noqa: E402
+                               write_golden_manifest, write_golden_textures)
 
 GOLDEN = os.path.join(SRC, "tests", "fog", "golden")
 
@@ -157,23 +158,11 @@ class FogPipelineTest(PipelineTestCase):
         print("fog golden check:\n  " + "\n  ".join(lines))
 
     def update_goldens(self, fog, summary):
-        os.makedirs(GOLDEN, exist_ok=True)
-        old = {}
-        manifest = os.path.join(GOLDEN, "manifest.json")
-        if os.path.isfile(manifest):
-            with open(manifest) as f:
-                old = json.load(f)
-        for name in TEXTURES:
-            with open(os.path.join(GOLDEN, name + ".texels"), "wb") as f:
-                f.write(ktx2_texels(os.path.join(fog, name))[4])
-            state = "unchanged" if old.get("textures", {}).get(name) == summary["textures"][name] else "UPDATED"
-            print("golden %s: %s" % (name, state))
+        old = write_golden_textures(GOLDEN, fog, TEXTURES, summary)
         for sky in SKIES:
             state = "unchanged" if old.get("parameters", {}).get(sky) == summary["parameters"][sky] else "UPDATED"
             print("golden parameters %s: %s" % (sky, state))
-        with open(manifest, "w") as f:
-            json.dump(summary, f, indent=2, sort_keys=True)
-            f.write("\n")
+        write_golden_manifest(GOLDEN, summary)
 
     def test_unknown_basis_sky_is_an_error_at_its_line(self):
         self.edit("pipeline.yaml", "skies: [clear, hazed, cloudy2]", "skies: [clear, hazed, cloudy9]")

@@ -104,6 +104,29 @@ def check_codes(test, name, level, golden_path):
                                                               "" if worst == 1 else "s")
 
 
+def write_golden_textures(golden, folder, textures, summary):
+    """SKYBAKE_UPDATE_GOLDENS=1: stores the textures' texels under `golden`, says which changed
+    (against the manifest's `textures`), and returns the old manifest (empty if none)."""
+    os.makedirs(golden, exist_ok=True)
+    old = {}
+    manifest = os.path.join(golden, "manifest.json")
+    if os.path.isfile(manifest):
+        with open(manifest) as f:
+            old = json.load(f)
+    for name in textures:
+        with open(os.path.join(golden, name + ".texels"), "wb") as f:
+            f.write(ktx2_texels(os.path.join(folder, name))[4])
+        state = "unchanged" if old.get("textures", {}).get(name) == summary["textures"][name] else "UPDATED"
+        print("golden %s: %s" % (name, state))
+    return old
+
+
+def write_golden_manifest(golden, summary):
+    with open(os.path.join(golden, "manifest.json"), "w") as f:
+        json.dump(summary, f, indent=2, sort_keys=True)
+        f.write("\n")
+
+
 class LutPipelineTest(PipelineTestCase):
     def setUp(self):
         super().setUp()
@@ -191,21 +214,8 @@ class LutPipelineTest(PipelineTestCase):
         print("golden check:\n  " + "\n  ".join(lines))
 
     def update_goldens(self, luts, summary):
-        os.makedirs(GOLDEN, exist_ok=True)
-        old = {}
-        manifest = os.path.join(GOLDEN, "manifest.json")
-        if os.path.isfile(manifest):
-            with open(manifest) as f:
-                old = json.load(f).get("textures", {})
-        for name in TEXTURES:
-            level = ktx2_texels(os.path.join(luts, name))[4]
-            with open(os.path.join(GOLDEN, name + ".texels"), "wb") as f:
-                f.write(level)
-            state = "unchanged" if old.get(name) == summary["textures"][name] else "UPDATED"
-            print("golden %s: %s" % (name, state))
-        with open(manifest, "w") as f:
-            json.dump(summary, f, indent=2, sort_keys=True)
-            f.write("\n")
+        write_golden_textures(GOLDEN, luts, TEXTURES, summary)
+        write_golden_manifest(GOLDEN, summary)
 
 
 if __name__ == "__main__":
