@@ -144,6 +144,7 @@ int main(int argc, char** argv) {
   std::vector<double> elevations = {60, 20, 5, 0, -4, -10};
   bool no_variants = false, references_only = false;
   std::vector<std::string> methods;
+  std::vector<std::string> qualities = {"low", "medium", "high"};
   cli.app().add_option("--out", out_dir, "Output folder (CSV; references cached in <out>/references)");
   cli.app().add_option("--mie-dir", mie_dir, "Folder with the Mie tables of the atmospheres' particle types");
   cli.app().add_option("--atmospheres", atmospheres, "Atmospheres (atmospheres/<name>.yaml)")->delimiter(',');
@@ -151,6 +152,10 @@ int main(int argc, char** argv) {
   cli.app().add_flag("--no-variants", no_variants, "Skip the model simplifications");
   cli.app().add_flag("--references-only", references_only, "Only render (or check) the cached references");
   cli.app().add_option("--methods", methods, "Deterministic methods (default: every registered one)")->delimiter(',');
+  cli.app()
+      .add_option("--qualities", qualities, "Qualities of the deterministic methods (default: low,medium,high)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"low", "medium", "high"}));
   return cli.Run(argc, argv, [&] {
     const fs::path root = SKYBAKE_SOURCE_DIR;
     const SkyDirections D = ChartDirections();
@@ -238,7 +243,7 @@ int main(int argc, char** argv) {
       };
       if (methods.empty()) methods = SkyMethodNames();
       for (const std::string& name : methods) {
-        for (const char* q : {"low", "medium", "high"}) {
+        for (const std::string& q : qualities) {
           SkyMethodOptions o;
           o.quality = q;
           run_method(scene, name, o, "");
