@@ -29,7 +29,7 @@ import unittest
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "cli"))
 from skytest import SRC, PipelineTestCase, run, tool  # noqa: E402
 from test_lut_pipeline import (TINY_PARTICLE, check_codes, edges_run, ktx2_texels,  # noqa: E402
-                               write_golden_manifest, write_golden_textures)
+                               load_golden_manifest, write_golden_manifest, write_golden_textures)
 
 GOLDEN = os.path.join(SRC, "tests", "fog", "golden")
 
@@ -133,10 +133,7 @@ class FogPipelineTest(PipelineTestCase):
         if os.environ.get("SKYBAKE_UPDATE_GOLDENS") == "1":
             self.update_goldens(fog, summary)
             return
-        manifest = os.path.join(GOLDEN, "manifest.json")
-        self.assertTrue(os.path.isfile(manifest), "no goldens: run with SKYBAKE_UPDATE_GOLDENS=1")
-        with open(manifest) as f:
-            golden = json.load(f)
+        golden = load_golden_manifest(self, GOLDEN)
         self.assertEqual(summary["texel_grid"], golden["texel_grid"])
         lines = []
         for name in TEXTURES:

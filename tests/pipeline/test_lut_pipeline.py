@@ -121,6 +121,14 @@ def write_golden_textures(golden, folder, textures, summary):
     return old
 
 
+def load_golden_manifest(test, golden):
+    """The golden's manifest.json, or a test failure that says how to create it."""
+    manifest = os.path.join(golden, "manifest.json")
+    test.assertTrue(os.path.isfile(manifest), "no goldens: run with SKYBAKE_UPDATE_GOLDENS=1")
+    with open(manifest) as f:
+        return json.load(f)
+
+
 def write_golden_manifest(golden, summary):
     with open(os.path.join(golden, "manifest.json"), "w") as f:
         json.dump(summary, f, indent=2, sort_keys=True)
@@ -198,10 +206,7 @@ class LutPipelineTest(PipelineTestCase):
         if os.environ.get("SKYBAKE_UPDATE_GOLDENS") == "1":
             self.update_goldens(luts, summary)
             return
-        manifest = os.path.join(GOLDEN, "manifest.json")
-        self.assertTrue(os.path.isfile(manifest), "no goldens: run with SKYBAKE_UPDATE_GOLDENS=1")
-        with open(manifest) as f:
-            golden = json.load(f)
+        golden = load_golden_manifest(self, GOLDEN)
         for key in ("time_mapping", "skies", "budget_bytes"):
             self.assertEqual(summary[key], golden[key], key)
         for a, b in zip(summary["slice_zenith_deg"], golden["slice_zenith_deg"]):
