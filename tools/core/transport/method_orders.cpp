@@ -810,81 +810,139 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
   bool last_order_tail = false;
   const size_t wref = nw_ / 2;
   // The scattering step: J = sum_c sigma_s*_c P*_c applied to a radiance table, per radius a
-  // (nd x nd) kernel per wavelength, stored per unit sigma_s*.
-  auto scatter = [&](const std::vector<float>& Lin, std::vector<float>* Jout) {
-    // J_n = sum_c sigma_s*_c P*_c applied to L_{n-1}, per radius: a (nd x nd) kernel per wavelength.
+  // (nd x nd) kernel per wavelength, stored per unit sigma_s*. The kernel depends on the radius
+  // only, so it is built once and kept for every order when all radii fit in 768 MiB (medium:
+  // 17 x 192^2 x nw floats, 60 MiB at 24 wavelengths), else rebuilt per order and radius.
+  std::vector<double> ssc_total(nr * nw_, 0.0);  // sigma_s* at each radius node (m^-1)
+  for (size_t ri = 0; ri < nr; ++ri) {
+    std::vector<float> ssc(nw_);
+    for (size_t c = 0; c < nc_; ++c) {
+      SigmaS(c, radius_[ri] - R, true, ssc.data());
+      for (size_t w = 0; w < nw_; ++w) ssc_total[ri * nw_ + w] += ssc[w];
+    }
+  }
+  const size_t kernel_floats = nd * nd * nw_;
+  auto build_kernel = [&](size_t ri, float* kernel) {
+    const double r = radius_[ri];
+    // The mixture phase x scattering coefficient on the cos grid at this radius.
+    std::vector<float> mix(static_cast<size_t>(kPhaseGrid) * nw_, 0.0f), ssc(nw_);
+    for (size_t c = 0; c < nc_; ++c) {
+      SigmaS(c, r - R, true, ssc.data());
+      for (int g = 0; g < kPhaseGrid; ++g) {
+        for (size_t w = 0; w < nw_; ++w) mix[static_cast<size_t>(g) * nw_ + w] += ssc[w] * phase_star_[(c * kPhaseGrid + static_cast<size_t>(g)) * nw_ + w];
+      }
+    }
+    auto mix_at = [&](double mu, float scale, float* out) {
+      const double g = (std::clamp(mu, -1.0, 1.0) + 1.0) * 0.5 * (kPhaseGrid - 1);
+      const size_t gi = std::min(static_cast<size_t>(g), static_cast<size_t>(kPhaseGrid - 2));
+      const float t = static_cast<float>(g - static_cast<double>(gi));
+      const float* a = &mix[gi * nw_];
+      const float* b = &mix[(gi + 1) * nw_];
+      for (size_t w = 0; w < nw_; ++w) out[w] += scale * (a[w] + (b[w] - a[w]) * t);
+    };
+    std::fill(kernel, kernel + kernel_floats, 0.0f);
+    std::vector<double> cos_dphi(nphi * nphi), cos_sphi(nphi * nphi);
+    for (size_t q = 0; q < nphi; ++q) {
+      for (size_t q2 = 0; q2 < nphi; ++q2) {
+        const double phi = (q + 0.5) * kPi / s_.nphi, phi2 = (q2 + 0.5) * kPi / s_.nphi;
+        cos_dphi[q * nphi + q2] = std::cos(phi - phi2);
+        cos_sphi[q * nphi + q2] = std::cos(phi + phi2);
+      }
+    }
+    std::vector<double> vmu(nu_), vsn(nu_), vwidth(nu_);
+    for (size_t k = 0; k < nu_; ++k) {
+      vmu[k] = ViewMu(k, r);
+      vsn[k] = std::sqrt(std::max(0.0, 1.0 - vmu[k] * vmu[k]));
+      vwidth[k] = ViewWidth(k, r);
+    }
+    for (size_t i = 0; i < nd; ++i) {
+      const size_t k = i / nphi, q = i % nphi;
+      for (size_t j = 0; j < nd; ++j) {
+        const size_t k2 = j / nphi, q2 = j % nphi;
+        const float wgt = static_cast<float>(vwidth[k2] * kPi / s_.nphi);
+        float* out = &kernel[(i * nd + j) * nw_];
+        const double cc = vmu[k] * vmu[k2], ss = vsn[k] * vsn[k2];
+        mix_at(cc + ss * cos_dphi[q * nphi + q2], wgt, out);
+        mix_at(cc + ss * cos_sphi[q * nphi + q2], wgt, out);
+      }
+      if (s_.normalise) {
+        // Energy conservation of the discrete phase integral: every row must sum to
+        // sigma_s* (the phase function integrates to 1 over incoming directions); point
+        // sampling of a peaked phase on ~200 directions misses that by a few per cent.
+        std::vector<double> row(nw_, 0.0);
+        for (size_t j = 0; j < nd; ++j) {
+          const float* kv = &kernel[(i * nd + j) * nw_];
+          for (size_t w = 0; w < nw_; ++w) row[w] += kv[w];
+        }
+        std::vector<float> scale(nw_, 1.0f);
+        for (size_t w = 0; w < nw_; ++w) scale[w] = row[w] > 0.0 ? static_cast<float>(ssc_total[ri * nw_ + w] / row[w]) : 1.0f;
+        for (size_t j = 0; j < nd; ++j) {
+          float* kv = &kernel[(i * nd + j) * nw_];
+          for (size_t w = 0; w < nw_; ++w) kv[w] *= scale[w];
+        }
+      }
+    }
+  };
+  std::vector<float> kernels;
+  if (nr * kernel_floats * sizeof(float) <= (size_t{768} << 20)) {
+    kernels.resize(nr * kernel_floats);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nr, 1), [&](const tbb::blocked_range<size_t>& rg) {
-      std::vector<float> kernel(nd * nd * nw_), mix(static_cast<size_t>(kPhaseGrid) * nw_), ssc(nw_);
-      for (size_t ri = rg.begin(); ri != rg.end(); ++ri) {
-        const double r = radius_[ri];
-        // The mixture phase x scattering coefficient on the cos grid at this radius.
-        std::fill(mix.begin(), mix.end(), 0.0f);
-        std::vector<double> ssc_total(nw_, 0.0);
-        for (size_t c = 0; c < nc_; ++c) {
-          SigmaS(c, r - R, true, ssc.data());
-          for (size_t w = 0; w < nw_; ++w) ssc_total[w] += ssc[w];
-          for (int g = 0; g < kPhaseGrid; ++g) {
-            for (size_t w = 0; w < nw_; ++w) mix[static_cast<size_t>(g) * nw_ + w] += ssc[w] * phase_star_[(c * kPhaseGrid + static_cast<size_t>(g)) * nw_ + w];
-          }
+      for (size_t ri = rg.begin(); ri != rg.end(); ++ri) build_kernel(ri, &kernels[ri * kernel_floats]);
+    });
+  }
+  auto scatter = [&](const std::vector<float>& Lin, std::vector<float>* Jout) {
+    // J_n = sum_c sigma_s*_c P*_c applied to L_{n-1}, per radius: a (nd x nd) kernel per
+    // wavelength. Tasks are (radius, block of 4 sun nodes): each kernel element loaded is used
+    // for 4 sun nodes (the product is load-bound otherwise).
+    constexpr size_t kSunBlock = 4;
+    const size_t nsb = (ns_ + kSunBlock - 1) / kSunBlock;
+    auto apply = [&](size_t ri, size_t sb, const float* kernel) {
+      const size_t s0 = sb * kSunBlock, s1 = std::min(ns_, s0 + kSunBlock);
+      for (size_t i = 0; i < nd; ++i) {
+        float* jo[kSunBlock];
+        const float* lv[kSunBlock];
+        for (size_t b = 0; b < kSunBlock; ++b) {
+          const size_t si = std::min(s0 + b, s1 - 1);  // a short last block repeats its last node (not stored twice)
+          jo[b] = &(*Jout)[(((ri * ns_ + si) * nd) + i) * nw_];
+          lv[b] = &Lin[((ri * ns_ + si) * nd) * nw_];
         }
-        auto mix_at = [&](double mu, float scale, float* out) {
-          const double g = (std::clamp(mu, -1.0, 1.0) + 1.0) * 0.5 * (kPhaseGrid - 1);
-          const size_t gi = std::min(static_cast<size_t>(g), static_cast<size_t>(kPhaseGrid - 2));
-          const float t = static_cast<float>(g - static_cast<double>(gi));
-          const float* a = &mix[gi * nw_];
-          const float* b = &mix[(gi + 1) * nw_];
-          for (size_t w = 0; w < nw_; ++w) out[w] += scale * (a[w] + (b[w] - a[w]) * t);
-        };
-        std::fill(kernel.begin(), kernel.end(), 0.0f);
-        for (size_t i = 0; i < nd; ++i) {
-          const size_t k = i / nphi, q = i % nphi;
-          const double mu = ViewMu(k, r), phi = (q + 0.5) * kPi / s_.nphi;
-          const double sn = std::sqrt(std::max(0.0, 1.0 - mu * mu));
+        float acc[kSunBlock][64];
+        for (size_t w0 = 0; w0 < nw_; w0 += 64) {
+          const size_t wn = std::min<size_t>(64, nw_ - w0);
+          for (size_t b = 0; b < kSunBlock; ++b) std::fill(acc[b], acc[b] + wn, 0.0f);
           for (size_t j = 0; j < nd; ++j) {
-            const size_t k2 = j / nphi, q2 = j % nphi;
-            const double phi2 = (q2 + 0.5) * kPi / s_.nphi;
-            const float wgt = static_cast<float>(ViewWidth(k2, r) * kPi / s_.nphi);
-            float* out = &kernel[(i * nd + j) * nw_];
-            const double mu2 = ViewMu(k2, r);
-            const double sn2 = std::sqrt(std::max(0.0, 1.0 - mu2 * mu2));
-            mix_at(mu * mu2 + sn * sn2 * std::cos(phi - phi2), wgt, out);
-            mix_at(mu * mu2 + sn * sn2 * std::cos(phi + phi2), wgt, out);
-          }
-          if (s_.normalise) {
-            // Energy conservation of the discrete phase integral: every row must sum to
-            // sigma_s* (the phase function integrates to 1 over incoming directions); point
-            // sampling of a peaked phase on ~200 directions misses that by a few per cent.
-            std::vector<double> row(nw_, 0.0);
-            for (size_t j = 0; j < nd; ++j) {
-              const float* kv = &kernel[(i * nd + j) * nw_];
-              for (size_t w = 0; w < nw_; ++w) row[w] += kv[w];
-            }
-            std::vector<float> scale(nw_, 1.0f);
-            for (size_t w = 0; w < nw_; ++w) scale[w] = row[w] > 0.0 ? static_cast<float>(ssc_total[w] / row[w]) : 1.0f;
-            for (size_t j = 0; j < nd; ++j) {
-              float* kv = &kernel[(i * nd + j) * nw_];
-              for (size_t w = 0; w < nw_; ++w) kv[w] *= scale[w];
+            const float* kv = &kernel[(i * nd + j) * nw_ + w0];
+            for (size_t b = 0; b < kSunBlock; ++b) {
+              const float* l = lv[b] + j * nw_ + w0;
+              for (size_t w = 0; w < wn; ++w) acc[b][w] += kv[w] * l[w];
             }
           }
-        }
-        for (size_t si = 0; si < ns_; ++si) {
-          for (size_t i = 0; i < nd; ++i) {
-            float* jo = &(*Jout)[(((ri * ns_ + si) * nd) + i) * nw_];
-            std::fill(jo, jo + nw_, 0.0f);
-            for (size_t j = 0; j < nd; ++j) {
-              const float* kv = &kernel[(i * nd + j) * nw_];
-              const float* lv = &Lin[(((ri * ns_ + si) * nd) + j) * nw_];
-              for (size_t w = 0; w < nw_; ++w) jo[w] += kv[w] * lv[w];
+          // Stored per unit scattering coefficient (J / sigma_s*: the phase-weighted mean
+          // radiance), multiplied back by sigma_s* where it is used. Interpolating J itself
+          // between radius nodes smears a thin dense layer's source over the whole interval:
+          // a 1 km water cloud of optical depth 8 then amplified each order by 1.29.
+          for (size_t b = 0; b < s1 - s0; ++b) {
+            for (size_t w = 0; w < wn; ++w) {
+              const double st = ssc_total[ri * nw_ + w0 + w];
+              jo[b][w0 + w] = st > 0.0 ? static_cast<float>(acc[b][w] / st) : 0.0f;
             }
-            // Stored per unit scattering coefficient (J / sigma_s*: the phase-weighted mean
-            // radiance), multiplied back by sigma_s* where it is used. Interpolating J itself
-            // between radius nodes smears a thin dense layer's source over the whole interval:
-            // a 1 km water cloud of optical depth 8 then amplified each order by 1.29.
-            for (size_t w = 0; w < nw_; ++w) jo[w] = ssc_total[w] > 0.0 ? static_cast<float>(jo[w] / ssc_total[w]) : 0.0f;
           }
         }
       }
-    });
+    };
+    if (!kernels.empty()) {
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, nr * nsb, 1), [&](const tbb::blocked_range<size_t>& rg) {
+        for (size_t idx = rg.begin(); idx != rg.end(); ++idx) apply(idx / nsb, idx % nsb, &kernels[(idx / nsb) * kernel_floats]);
+      });
+    } else {
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, nr, 1), [&](const tbb::blocked_range<size_t>& rg) {
+        std::vector<float> kernel(kernel_floats);
+        for (size_t ri = rg.begin(); ri != rg.end(); ++ri) {
+          build_kernel(ri, kernel.data());
+          for (size_t sb = 0; sb < nsb; ++sb) apply(ri, sb, kernel.data());
+        }
+      });
+    }
   };
   // The transport step: L = int T* sigma_s* J dt along every table ray + the ground's
   // reflection of the irradiance of Lin (the radiance the sources J came from).
