@@ -73,3 +73,32 @@ TEST(Interp, Trapezoid) {
   std::vector<double> x{0, 1, 2, 3}, y{0, 1, 2, 3};
   EXPECT_DOUBLE_EQ(Trapezoid(x, y), 4.5);  // integral of x from 0 to 3
 }
+
+// IntervalLocator must give FindInterval's answer everywhere, nodes and just-off-node values
+// included, on grids as the sky uses them (piecewise uniform with accumulated rounding,
+// quadratic, irregular).
+TEST(Interp, IntervalLocatorMatchesFindInterval) {
+  std::vector<std::vector<double>> grids;
+  std::vector<double> g;
+  for (double a = 0; a < 80; a += 1.0) g.push_back(a);
+  for (double a = 80; a < 110; a += 0.05) g.push_back(a);  // accumulated rounding, as sun_theta_deg_
+  for (double a = 110; a <= 125 + 1e-9; a += 1.0) g.push_back(a);
+  grids.push_back(g);
+  g.clear();
+  for (int i = 0; i < 48; ++i) g.push_back(6.36e6 + 1e5 * std::pow(i / 47.0, 2.0));
+  grids.push_back(g);
+  grids.push_back({-3.0, -2.999, 0.0, 1e-9, 5.0, 5.5, 100.0});
+  for (const std::vector<double>& x : grids) {
+    IntervalLocator loc(x);
+    const double lo = x.front() - 1.0, hi = x.back() + 1.0;
+    for (int i = 0; i <= 20000; ++i) {
+      const double v = lo + (hi - lo) * i / 20000.0;
+      ASSERT_EQ(loc.Find(v), FindInterval(x, v)) << v;
+    }
+    for (double node : x) {
+      for (double v : {node, std::nextafter(node, -1e300), std::nextafter(node, 1e300)}) {
+        ASSERT_EQ(loc.Find(v), FindInterval(x, v)) << v;
+      }
+    }
+  }
+}

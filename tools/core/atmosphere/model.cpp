@@ -79,6 +79,7 @@ void AtmosphereModel::Finalize() {
     if (std::abs(altitude_m[i] - static_cast<double>(i) * uniform_step_) > 1e-9 * altitude_m.back()) uniform_step_ = 0.0;
   }
   if (uniform_step_ > 0.0 && altitude_m.back() - altitude_m[nl - 2] > uniform_step_ * (1 + 1e-12)) uniform_step_ = 0.0;
+  level_locator_ = IntervalLocator(altitude_m);
   extinction_.assign(nl * nw, 0.0);
   scattering_.assign(nl * nw, 0.0);
   for (const MediumComponent& c : components) {
@@ -101,9 +102,7 @@ AtmosphereModel::Cell AtmosphereModel::Locate(double z) const {
     const size_t i = std::min(static_cast<size_t>(z / uniform_step_), nl - 2);
     return {i, std::clamp((z - altitude_m[i]) / (altitude_m[i + 1] - altitude_m[i]), 0.0, 1.0)};
   }
-  auto it = std::upper_bound(altitude_m.begin(), altitude_m.end(), z);
-  size_t i = static_cast<size_t>(it - altitude_m.begin()) - 1;
-  i = std::min(i, nl - 2);
+  const size_t i = level_locator_.Find(z);
   return {i, (z - altitude_m[i]) / (altitude_m[i + 1] - altitude_m[i])};
 }
 

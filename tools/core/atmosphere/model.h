@@ -19,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include "io/interp.h"
+
 namespace skybake {
 
 // A phase function per wavelength (sr^-1, integral over the sphere = 1) with importance
@@ -124,6 +126,7 @@ class AtmosphereModel {
   double VerticalOpticalDepth(double a_m, double b_m, size_t wl) const;
 
  private:
+  IntervalLocator level_locator_;    // levels (non-uniform grids)
   double uniform_step_ = 0.0;        // > 0: levels at i * step (the last interval may be shorter)
   std::vector<double> extinction_;  // [level * n_wl + wl]
   std::vector<double> scattering_;  // [level * n_wl + wl]

@@ -21,6 +21,19 @@ size_t FindInterval(const std::vector<double>& x, double v) {
   return std::min(i, x.size() - 2);
 }
 
+IntervalLocator::IntervalLocator(const std::vector<double>& x) : x_(x) {
+  SKYBAKE_CHECK_GE(x.size(), size_t{2});
+  for (size_t i = 1; i < x.size(); ++i) SKYBAKE_CHECK_LT(x[i - 1], x[i]);
+  const size_t nb = 4 * x.size();
+  scale_ = static_cast<double>(nb) / (x.back() - x.front());
+  start_.resize(nb);
+  for (size_t b = 0; b < nb; ++b) {
+    // One interval below the edge's: v in bucket b may round to just under the edge.
+    const size_t i = FindInterval(x, x.front() + static_cast<double>(b) / scale_);
+    start_[b] = static_cast<uint32_t>(i > 0 ? i - 1 : 0);
+  }
+}
+
 bool Interpolant1D::Covers(double lo, double hi) const {
   double span = std::max(1.0, std::abs(x_.back() - x_.front()));
   double tol = 1e-12 * span;

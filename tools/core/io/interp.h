@@ -10,6 +10,8 @@
 // ranges use Covers() first and report a located InputError.
 #pragma once
 
+#include <algorithm>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -40,6 +42,30 @@ class Interpolant1D {
 
 // Index i such that x[i] <= v < x[i+1] (clamped to [0, n-2]); x strictly increasing, n >= 2.
 size_t FindInterval(const std::vector<double>& x, double v);
+
+// FindInterval in O(1) for a fixed grid (the hot lookups of the deterministic sky: altitude
+// levels, sun-angle and radius nodes): the interval at the lower edge of each of 4n uniform
+// buckets over [x0, x_{n-1}], then a forward scan. Same answer as FindInterval (tested).
+class IntervalLocator {
+ public:
+  IntervalLocator() = default;
+  explicit IntervalLocator(const std::vector<double>& x);
+  size_t Find(double v) const {
+    const size_t n = x_.size();
+    if (!(v > x_.front())) return 0;
+    if (v >= x_.back()) return n - 2;
+    const size_t b = std::min(start_.size() - 1, static_cast<size_t>((v - x_.front()) * scale_));
+    size_t i = start_[b];
+    while (i + 2 < n && x_[i + 1] <= v) ++i;
+    return i;
+  }
+  const std::vector<double>& x() const { return x_; }
+
+ private:
+  std::vector<double> x_;
+  std::vector<uint32_t> start_;
+  double scale_ = 0.0;
+};
 
 // Integral of y over x by the trapezoid rule.
 double Trapezoid(const std::vector<double>& x, const std::vector<double>& y);

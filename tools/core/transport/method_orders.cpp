@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "io/error.h"
+#include "io/interp.h"
 
 namespace skybake {
 
@@ -109,6 +110,13 @@ struct Lerp {
   size_t i = 0;
   double t = 0.0;
 };
+Lerp Locate(const IntervalLocator& loc, double v) {
+  const std::vector<double>& x = loc.x();
+  if (v <= x.front()) return {0, 0.0};
+  if (v >= x.back()) return {x.size() - 2, 1.0};
+  const size_t i = loc.Find(v);
+  return {i, (v - x[i]) / (x[i + 1] - x[i])};
+}
 Lerp Locate(const std::vector<double>& x, double v) {
   if (v <= x.front()) return {0, 0.0};
   if (v >= x.back()) return {x.size() - 2, 1.0};
@@ -154,8 +162,12 @@ class OrdersMethod : public SkyMethod {
   // --- medium: per model level, wavelength innermost (float)
   void PrepareMedium();
   // Coefficients at altitude z into per-wavelength buffers.
-  void SigmaT(double z, bool scaled, float* out) const;
-  void SigmaS(size_t c, double z, bool scaled, float* out) const;
+  void SigmaT(double z, bool scaled, float* out) const { SigmaT(m_.Locate(z), scaled, out); }
+  void SigmaS(size_t c, double z, bool scaled, float* out) const { SigmaS(c, m_.Locate(z), scaled, out); }
+  void SigmaT(const AtmosphereModel::Cell& cell, bool scaled, float* out) const;
+  void SigmaS(size_t c, const AtmosphereModel::Cell& cell, bool scaled, float* out) const;
+  // sigma_t at one wavelength (the step placement's reference).
+  float SigmaTAt(double z, bool scaled, size_t w) const;
 
   // --- sun transmittance averaged over the solar disk, T(r, theta_s) per wavelength
   void BuildSunTables();
@@ -226,6 +238,7 @@ class OrdersMethod : public SkyMethod {
   // Sun transmittance tables: radius nodes x theta nodes x nw (unscaled and scaled).
   std::vector<double> sun_r_, sun_theta_deg_;
   std::vector<float> sun_t_, sun_t_star_;
+  IntervalLocator sun_r_loc_, sun_theta_loc_;
 
   // MS tables.
   std::vector<double> radius_;  // radius nodes (m); obs_index_ is the observer's
@@ -307,8 +320,14 @@ void OrdersMethod::PrepareMedium() {
   }
 }
 
-void OrdersMethod::SigmaT(double z, bool scaled, float* out) const {
+float OrdersMethod::SigmaTAt(double z, bool scaled, size_t w) const {
   const AtmosphereModel::Cell c = m_.Locate(z);
+  const std::vector<float>& s = scaled ? sigma_t_star_ : sigma_t_;
+  const float a = s[c.i * nw_ + w], b = s[(c.i + 1) * nw_ + w];
+  return a + (b - a) * static_cast<float>(c.t);
+}
+
+void OrdersMethod::SigmaT(const AtmosphereModel::Cell& c, bool scaled, float* out) const {
   const std::vector<float>& s = scaled ? sigma_t_star_ : sigma_t_;
   const float* a = &s[c.i * nw_];
   const float* b = &s[(c.i + 1) * nw_];
@@ -316,8 +335,7 @@ void OrdersMethod::SigmaT(double z, bool scaled, float* out) const {
   for (size_t w = 0; w < nw_; ++w) out[w] = a[w] + (b[w] - a[w]) * t;
 }
 
-void OrdersMethod::SigmaS(size_t comp, double z, bool scaled, float* out) const {
-  const AtmosphereModel::Cell c = m_.Locate(z);
+void OrdersMethod::SigmaS(size_t comp, const AtmosphereModel::Cell& c, bool scaled, float* out) const {
   const size_t nl = m_.levels();
   const std::vector<float>& s = scaled ? sigma_s_star_ : sigma_s_;
   const float* a = &s[(comp * nl + c.i) * nw_];
@@ -364,6 +382,8 @@ void OrdersMethod::BuildSunTables() {
   for (double a = 80; a < 110; a += 0.05) sun_theta_deg_.push_back(a);
   for (double a = 110; a <= 125 + 1e-9; a += 1.0) sun_theta_deg_.push_back(a);
   const size_t nt = sun_theta_deg_.size();
+  sun_r_loc_ = IntervalLocator(sun_r_);
+  sun_theta_loc_ = IntervalLocator(sun_theta_deg_);
   std::vector<float> base(nr * nt * nw_), base_star(nr * nt * nw_);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, static_cast<size_t>(nr) * nt, 8), [&](const tbb::blocked_range<size_t>& rg) {
     std::vector<double> tau, tau_f;
@@ -433,8 +453,8 @@ void OrdersMethod::BuildSunTables() {
 }
 
 void OrdersMethod::SunTransmittance(double r, double mu_s, bool scaled, float* out) const {
-  const Lerp lr = Locate(sun_r_, r);
-  const Lerp lt = Locate(sun_theta_deg_, std::acos(std::clamp(mu_s, -1.0, 1.0)) / kDeg);
+  const Lerp lr = Locate(sun_r_loc_, r);
+  const Lerp lt = Locate(sun_theta_loc_, std::acos(std::clamp(mu_s, -1.0, 1.0)) / kDeg);
   const size_t nt = sun_theta_deg_.size();
   const std::vector<float>& tab = scaled ? sun_t_star_ : sun_t_;
   const float* p00 = &tab[(lr.i * nt + lt.i) * nw_];
@@ -616,6 +636,14 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
     std::vector<float> wt;
     std::vector<float> ssc;    // [step * nw + w] scaled scattering coefficient sigma_s* at the step (m^-1)
     std::vector<RadialView> rv;  // the interpolation's radius/view part at each step
+    // The same as table offsets: per step the 4 (radius, view) corners' cell offsets
+    // Cell(ri, 0, k, 0) and weights (Cell() is a sum of a radius/view part and a sun/azimuth part).
+    struct Corners {
+      uint32_t off[4];
+      float w[4];
+    };
+    std::vector<Corners> rc;
+    std::vector<float> g;      // [step * nw + w] wt x ssc: the step's weight of J (m^-1 m)
     bool ground = false;
     double d = 0.0;
     std::vector<float> trans_end;  // at the ground
@@ -698,6 +726,20 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
       }
       f.trans_end.resize(nw_);
       for (size_t w = 0; w < nw_; ++w) f.trans_end[w] = std::exp(-cum_w.back()[w]);
+      f.g.resize(nt * nw_);
+      for (size_t i = 0; i < nt * nw_; ++i) f.g[i] = f.wt[i] * f.ssc[i];
+      for (const RadialView& v : f.rv) {
+        Family::Corners c{};
+        for (int dr = 0; dr < 2; ++dr) {
+          const size_t rn = std::min(v.ri + static_cast<size_t>(dr), nr - 1);
+          for (int dk = 0; dk < 2; ++dk) {
+            const size_t kk = dk ? v.k1[dr] : v.k0[dr];
+            c.off[2 * dr + dk] = static_cast<uint32_t>(Cell(rn, 0, kk, 0));
+            c.w[2 * dr + dk] = static_cast<float>(v.wr[dr] * (dk ? v.tk[dr] : 1.0 - v.tk[dr]));
+          }
+        }
+        f.rc.push_back(c);
+      }
     }
   });
 
@@ -961,9 +1003,28 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
           std::fill(acc.begin(), acc.end(), 0.0f);
           const SunAzimuth* sa = sun_az.empty() ? nullptr : &sun_az[Cell(ri, si, k, q) * nt];
           for (size_t m = 0; m < f.t.size(); ++m) {
-            std::fill(jv.begin(), jv.end(), 0.0f);
-            Interpolate(Jin, f.rv[m], sa != nullptr ? sa[m] : step_sun_azimuth(f, m, r, ts, nu), 1.0, jv.data());
-            for (size_t w = 0; w < nw_; ++w) acc[w] += f.wt[m * nw_ + w] * f.ssc[m * nw_ + w] * jv[w];
+            // The 16-corner gather of J (radius x view x sun x azimuth), the hot loop of the
+            // solve: offsets and weights split into the step's radius/view part (per family)
+            // and its sun/azimuth part (per cell).
+            const SunAzimuth p = sa != nullptr ? sa[m] : step_sun_azimuth(f, m, r, ts, nu);
+            if (p.si == kNoSun) continue;
+            const size_t so = (static_cast<size_t>(p.si) * nu_) * nphi + p.q0;
+            const size_t sofs[4] = {so, so + 1, so + nu_ * nphi, so + nu_ * nphi + 1};
+            const float ws[4] = {(1.0f - p.ts) * (1.0f - p.tq), (1.0f - p.ts) * p.tq, p.ts * (1.0f - p.tq), p.ts * p.tq};
+            const Family::Corners& c = f.rc[m];
+            float* jvp = jv.data();
+            std::fill(jvp, jvp + nw_, 0.0f);
+            for (int a = 0; a < 4; ++a) {
+              if (c.w[a] == 0.0f) continue;
+              for (int b = 0; b < 4; ++b) {
+                const float wab = c.w[a] * ws[b];
+                if (wab == 0.0f) continue;
+                const float* v = &Jin[(c.off[a] + sofs[b]) * nw_];
+                for (size_t w = 0; w < nw_; ++w) jvp[w] += wab * v[w];
+              }
+            }
+            const float* gm = &f.g[m * nw_];
+            for (size_t w = 0; w < nw_; ++w) acc[w] += gm[w] * jvp[w];
           }
           if (f.ground) {
             const double mus_g = (r * std::cos(ts) + f.d * nu) / R;
@@ -1087,8 +1148,7 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
       for (int p = 0; p < nf; ++p) {
         const double tm = (p + 0.5) * length / nf;
         const double rr = std::sqrt(r * r + 2.0 * r * mu * tm + tm * tm);
-        SigmaT(rr - R, false, st.data());
-        cum[static_cast<size_t>(p) + 1] = cum[static_cast<size_t>(p)] + st[wref] * length / nf;
+        cum[static_cast<size_t>(p) + 1] = cum[static_cast<size_t>(p)] + SigmaTAt(rr - R, false, wref) * length / nf;
       }
       const double tau_tot = std::max(cum.back(), 1e-12);
       std::vector<double> s_at(static_cast<size_t>(nf) + 1);
@@ -1109,10 +1169,11 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
           // Optical depth from the observer to t: advance from t_prev with the midpoint value.
           const double tmid = 0.5 * (t_prev + t);
           const double rmid = std::sqrt(r * r + 2.0 * r * mu * tmid + tmid * tmid);
-          SigmaT(rmid - R, false, st.data());
+          const AtmosphereModel::Cell cmid = m_.Locate(rmid - R), cell = m_.Locate(rr - R);
+          SigmaT(cmid, false, st.data());
           for (size_t w = 0; w < nw_; ++w) tau[w] += st[w] * (t - t_prev);
           if (segment != nullptr) {
-            SigmaT(rmid - R, true, st.data());
+            SigmaT(cmid, true, st.data());
             for (size_t w = 0; w < nw_; ++w) tau_star[w] += st[w] * (t - t_prev);
           }
           t_prev = t;
@@ -1120,12 +1181,16 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
           SunTransmittance(rr, mus, false, tsun.data());
           for (size_t w = 0; w < nw_; ++w) ssc[w] = 0.0f;
           for (size_t c = 0; c < nc_; ++c) {
-            SigmaS(c, rr - R, false, st.data());
+            SigmaS(c, cell, false, st.data());
             for (size_t w = 0; w < nw_; ++w) ssc[w] += st[w] * pc[c * nw_ + w];
           }
           const float hw = static_cast<float>(segment == nullptr || segment->single_scattering ? 0.5 * h : 0.0);
-          for (size_t w = 0; w < nw_; ++w) {
-            acc[w] += hw * static_cast<float>(std::exp(-tau[w])) * ssc[w] * tsun[w] * static_cast<float>(sun_e_[w]);
+          if (hw > 0.0f) {
+            // Single precision exp: the radiance is accumulated in float anyway (and expf is
+            // ~3x cheaper; it was a fifth of a clear-sky LUT).
+            for (size_t w = 0; w < nw_; ++w) {
+              acc[w] += hw * std::exp(-static_cast<float>(tau[w])) * ssc[w] * tsun[w] * static_cast<float>(sun_e_[w]);
+            }
           }
           if (segment != nullptr) {
             // Multiple scattering of the segment: the tabulated source J_ms* at this point, in
@@ -1153,7 +1218,7 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
             }
             std::fill(sst.begin(), sst.end(), 0.0f);
             for (size_t c = 0; c < nc_; ++c) {
-              SigmaS(c, rr - R, true, st.data());
+              SigmaS(c, cell, true, st.data());
               for (size_t w = 0; w < nw_; ++w) sst[w] += st[w];
             }
             for (size_t w = 0; w < nw_; ++w) seg_ms[w] += 0.5 * h * std::exp(-tau_star[w]) * sst[w] * jv[w];
