@@ -1114,131 +1114,169 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
   const size_t nd = nu_ * static_cast<size_t>(s_.nphi);
   // Log-linear interpolation of the MS table in the sun angle (exact for exponential twilight decay).
   const Lerp ls = Locate(sun_theta_rad_, ts);
-  std::vector<float> tsun(nw_), ssc(nw_), st(nw_), acc(nw_), ms0(nw_), ms1(nw_), pc(nc_ * nw_), jv(nw_), jv1(nw_), sst(nw_);
-  std::vector<double> tau(nw_), tau_star(nw_), seg_ms(nw_);
+  std::vector<float> tsun(nw_), st(nw_), acc(nw_), ms0(nw_), ms1(nw_), pc(nc_ * nw_), jv(nw_), jv1(nw_);
+  std::vector<double> seg_ms(nw_);
+
+  // What along a view ray does not depend on the sun or the azimuth - the steps, the medium at
+  // each point and its transmittance from the observer - is computed once per view zenith
+  // cosine and reused while the directions share it (a LUT row, an ambient ring: 32-128
+  // directions per call; it was two thirds of a clear-sky LUT's render).
+  struct Point {
+    double t = 0.0, rr = 0.0, mu2 = 0.0;
+  };
+  struct Ray {
+    double mu = 2.0;  // none yet
+    double length = 0.0;
+    bool ground = false;
+    std::vector<Point> pts;
+    std::vector<float> e;      // [(p * nc + c) * nw + w]: half-step x T(0, t_p) x sigma_s,c (single scattering weight)
+    std::vector<float> seg;    // [p * nw + w]: half-step x T*(0, t_p) x sigma_s* (segments' multiple scattering)
+    std::vector<float> t_end;  // [w] transmittance to the ray's end (the ground)
+  } ray;
+  auto build_ray = [&](double mu) {
+    ray.mu = mu;
+    ray.pts.clear();
+    ray.e.clear();
+    ray.seg.clear();
+    const double disc_g = r * r * (mu * mu - 1.0) + R * R;
+    // Segments never include the ground surface (transport/view_segment.h).
+    ray.ground = segment == nullptr && mu < 0.0 && disc_g >= 0.0;
+    if (segment != nullptr) {
+      ray.length = SegmentEnd(m_, observer_altitude_m, mu, *segment);
+    } else {
+      ray.length = mu < 0.0 && disc_g >= 0.0 ? -r * mu - std::sqrt(std::max(0.0, disc_g))
+                                             : -r * mu + std::sqrt(std::max(0.0, r * r * (mu * mu - 1.0) + top * top));
+    }
+    const double length = ray.length;
+    std::vector<double> tau(nw_, 0.0), tau_star(nw_, 0.0);
+    ray.t_end.assign(nw_, 1.0f);
+    if (length <= 0.0) return;
+    // Steps uniform in the parameter s = (tau_ref/tau_tot + t/length)/2 computed on a fine
+    // uniform sub-grid at the middle wavelength (as the table rays).
+    const int nf = s_.fine;
+    std::vector<double> cum(static_cast<size_t>(nf) + 1, 0.0);
+    const size_t wref = nw_ / 2;
+    for (int p = 0; p < nf; ++p) {
+      const double tm = (p + 0.5) * length / nf;
+      const double rr = std::sqrt(r * r + 2.0 * r * mu * tm + tm * tm);
+      cum[static_cast<size_t>(p) + 1] = cum[static_cast<size_t>(p)] + SigmaTAt(rr - R, false, wref) * length / nf;
+    }
+    const double tau_tot = std::max(cum.back(), 1e-12);
+    std::vector<double> s_at(static_cast<size_t>(nf) + 1);
+    for (int p = 0; p <= nf; ++p) s_at[static_cast<size_t>(p)] = 0.5 * (cum[static_cast<size_t>(p)] / tau_tot + static_cast<double>(p) / nf);
+    const IntervalLocator s_loc(s_at);
+    auto t_of_s = [&](double sv) {
+      const Lerp l = Locate(s_loc, sv);
+      return (static_cast<double>(l.i) + l.t) * length / nf;
+    };
+    // Gauss-Legendre (2 points) on each step; optical depth accumulated with the same rule.
+    static const double kG = 0.5773502691896257;
+    double t_prev = 0.0;
+    for (int m = 0; m < s_.nss; ++m) {
+      const double t0 = t_of_s(static_cast<double>(m) / s_.nss), t1 = t_of_s(static_cast<double>(m + 1) / s_.nss);
+      const double h = t1 - t0;
+      for (double g : {-kG, kG}) {
+        const double t = 0.5 * (t0 + t1) + 0.5 * g * h;
+        const double rr = std::sqrt(r * r + 2.0 * r * mu * t + t * t);
+        // Optical depth from the observer to t: advance from t_prev with the midpoint value.
+        const double tmid = 0.5 * (t_prev + t);
+        const double rmid = std::sqrt(r * r + 2.0 * r * mu * tmid + tmid * tmid);
+        const AtmosphereModel::Cell cmid = m_.Locate(rmid - R), cell = m_.Locate(rr - R);
+        SigmaT(cmid, false, st.data());
+        for (size_t w = 0; w < nw_; ++w) tau[w] += st[w] * (t - t_prev);
+        if (segment != nullptr) {
+          SigmaT(cmid, true, st.data());
+          for (size_t w = 0; w < nw_; ++w) tau_star[w] += st[w] * (t - t_prev);
+        }
+        t_prev = t;
+        ray.pts.push_back({t, rr, std::clamp((r * mu + t) / rr, -1.0, 1.0)});
+        const float hw = static_cast<float>(segment == nullptr || segment->single_scattering ? 0.5 * h : 0.0);
+        const size_t e0 = ray.e.size();
+        ray.e.resize(e0 + nc_ * nw_);
+        for (size_t c = 0; c < nc_; ++c) {
+          SigmaS(c, cell, false, st.data());
+          // Single precision exp: the radiance is accumulated in float anyway.
+          for (size_t w = 0; w < nw_; ++w) ray.e[e0 + c * nw_ + w] = hw * std::exp(-static_cast<float>(tau[w])) * st[w];
+        }
+        if (segment != nullptr) {
+          const size_t s0 = ray.seg.size();
+          ray.seg.resize(s0 + nw_, 0.0f);
+          for (size_t c = 0; c < nc_; ++c) {
+            SigmaS(c, cell, true, st.data());
+            for (size_t w = 0; w < nw_; ++w) ray.seg[s0 + w] += st[w];
+          }
+          for (size_t w = 0; w < nw_; ++w) ray.seg[s0 + w] *= static_cast<float>(0.5 * h * std::exp(-tau_star[w]));
+        }
+      }
+    }
+    if (ray.ground) {
+      // Finish the optical depth to the ground.
+      const double tmid = 0.5 * (t_prev + length);
+      const double rmid = std::sqrt(r * r + 2.0 * r * mu * tmid + tmid * tmid);
+      SigmaT(rmid - R, false, st.data());
+      for (size_t w = 0; w < nw_; ++w) ray.t_end[w] = static_cast<float>(std::exp(-(tau[w] + st[w] * (length - t_prev))));
+    }
+  };
+
   for (size_t d = 0; d < dirs.size(); ++d) {
     const double mu = std::clamp(dirs[d][2], -1.0, 1.0);
     const double sn = std::sqrt(std::max(0.0, 1.0 - mu * mu));
     const double cphi = sn > 1e-12 ? dirs[d][0] / sn : 1.0;
     const double nu = dirs[d][0] * std::sin(ts) + mu * std::cos(ts);  // the sun is (sin ts, 0, cos ts)
+    if (mu != ray.mu) build_ray(mu);
     // --- single scattering along the view ray (unscaled medium, full phase)
     for (size_t c = 0; c < nc_; ++c) {
       for (size_t w = 0; w < nw_; ++w) pc[c * nw_ + w] = static_cast<float>(phase_[c]->Eval(w, nu));
     }
-    const double disc_g = r * r * (mu * mu - 1.0) + R * R;
-    // Segments never include the ground surface (transport/view_segment.h).
-    const bool ground = segment == nullptr && mu < 0.0 && disc_g >= 0.0;
-    double length;
-    if (segment != nullptr) {
-      length = SegmentEnd(m_, observer_altitude_m, mu, *segment);
-    } else {
-      length = mu < 0.0 && disc_g >= 0.0 ? -r * mu - std::sqrt(std::max(0.0, disc_g))
-                                         : -r * mu + std::sqrt(std::max(0.0, r * r * (mu * mu - 1.0) + top * top));
-    }
     std::fill(acc.begin(), acc.end(), 0.0f);
-    std::fill(tau.begin(), tau.end(), 0.0);
-    std::fill(tau_star.begin(), tau_star.end(), 0.0);
     std::fill(seg_ms.begin(), seg_ms.end(), 0.0);
-    if (length > 0.0) {
-      // Steps uniform in the parameter s = (tau_ref/tau_tot + t/length)/2 computed on a fine
-      // uniform sub-grid at the middle wavelength (as the table rays).
-      const int nf = s_.fine;
-      std::vector<double> cum(static_cast<size_t>(nf) + 1, 0.0);
-      const size_t wref = nw_ / 2;
-      for (int p = 0; p < nf; ++p) {
-        const double tm = (p + 0.5) * length / nf;
-        const double rr = std::sqrt(r * r + 2.0 * r * mu * tm + tm * tm);
-        cum[static_cast<size_t>(p) + 1] = cum[static_cast<size_t>(p)] + SigmaTAt(rr - R, false, wref) * length / nf;
+    for (size_t p = 0; p < ray.pts.size(); ++p) {
+      const Point& pt = ray.pts[p];
+      const double mus = (r * std::cos(ts) + pt.t * nu) / pt.rr;
+      if (segment == nullptr || segment->single_scattering) {
+        SunTransmittance(pt.rr, mus, false, tsun.data());
+        const float* e = &ray.e[p * nc_ * nw_];
+        std::fill(st.begin(), st.end(), 0.0f);
+        for (size_t c = 0; c < nc_; ++c) {
+          for (size_t w = 0; w < nw_; ++w) st[w] += e[c * nw_ + w] * pc[c * nw_ + w];
+        }
+        for (size_t w = 0; w < nw_; ++w) acc[w] += st[w] * tsun[w] * static_cast<float>(sun_e_[w]);
       }
-      const double tau_tot = std::max(cum.back(), 1e-12);
-      std::vector<double> s_at(static_cast<size_t>(nf) + 1);
-      for (int p = 0; p <= nf; ++p) s_at[static_cast<size_t>(p)] = 0.5 * (cum[static_cast<size_t>(p)] / tau_tot + static_cast<double>(p) / nf);
-      auto t_of_s = [&](double sv) {
-        const Lerp l = Locate(s_at, sv);
-        return (static_cast<double>(l.i) + l.t) * length / nf;
-      };
-      // Gauss-Legendre (2 points) on each step; optical depth accumulated with the same rule.
-      static const double kG = 0.5773502691896257;
-      double t_prev = 0.0;
-      for (int m = 0; m < s_.nss; ++m) {
-        const double t0 = t_of_s(static_cast<double>(m) / s_.nss), t1 = t_of_s(static_cast<double>(m + 1) / s_.nss);
-        const double h = t1 - t0;
-        for (double g : {-kG, kG}) {
-          const double t = 0.5 * (t0 + t1) + 0.5 * g * h;
-          const double rr = std::sqrt(r * r + 2.0 * r * mu * t + t * t);
-          // Optical depth from the observer to t: advance from t_prev with the midpoint value.
-          const double tmid = 0.5 * (t_prev + t);
-          const double rmid = std::sqrt(r * r + 2.0 * r * mu * tmid + tmid * tmid);
-          const AtmosphereModel::Cell cmid = m_.Locate(rmid - R), cell = m_.Locate(rr - R);
-          SigmaT(cmid, false, st.data());
-          for (size_t w = 0; w < nw_; ++w) tau[w] += st[w] * (t - t_prev);
-          if (segment != nullptr) {
-            SigmaT(cmid, true, st.data());
-            for (size_t w = 0; w < nw_; ++w) tau_star[w] += st[w] * (t - t_prev);
-          }
-          t_prev = t;
-          const double mus = (r * std::cos(ts) + t * nu) / rr;
-          SunTransmittance(rr, mus, false, tsun.data());
-          for (size_t w = 0; w < nw_; ++w) ssc[w] = 0.0f;
-          for (size_t c = 0; c < nc_; ++c) {
-            SigmaS(c, cell, false, st.data());
-            for (size_t w = 0; w < nw_; ++w) ssc[w] += st[w] * pc[c * nw_ + w];
-          }
-          const float hw = static_cast<float>(segment == nullptr || segment->single_scattering ? 0.5 * h : 0.0);
-          if (hw > 0.0f) {
-            // Single precision exp: the radiance is accumulated in float anyway (and expf is
-            // ~3x cheaper; it was a fifth of a clear-sky LUT).
+      if (segment != nullptr) {
+        // Multiple scattering of the segment: the tabulated source J_ms* at this point, in
+        // its local frame, attenuated by the scaled medium (the TMS split's L* part).
+        const double mus_c = std::clamp(mus, -1.0, 1.0);
+        const double mu2 = pt.mu2;
+        const double denom = std::sqrt(std::max(1e-12, (1.0 - mu2 * mu2) * (1.0 - mus_c * mus_c)));
+        const double cphi2 = std::clamp((nu - mu2 * mus_c) / denom, -1.0, 1.0);
+        // Log-linear in the sun angle, as the sky's own multiple scattering below: between
+        // twilight nodes 1 deg apart the sources fall ~e-fold, and linear interpolation put
+        // the fog between nodes ~10 % above the nodes' (docs/fog.md, "Limits").
+        const SunAzimuth sa = SunAzimuthAt(std::acos(mus_c), cphi2);
+        std::fill(jv.begin(), jv.end(), 0.0f);
+        if (sa.si != kNoSun) {
+          const RadialView rv = RadialViewAt(pt.rr, mu2);
+          std::fill(jv1.begin(), jv1.end(), 0.0f);
+          Interpolate(jms_, rv, SunAzimuth{sa.si, sa.q0, 0.0f, sa.tq}, 1.0, jv.data());
+          if (sa.ts > 0.0f) {
+            Interpolate(jms_, rv, SunAzimuth{static_cast<uint16_t>(sa.si + 1), sa.q0, 0.0f, sa.tq}, 1.0, jv1.data());
             for (size_t w = 0; w < nw_; ++w) {
-              acc[w] += hw * std::exp(-static_cast<float>(tau[w])) * ssc[w] * tsun[w] * static_cast<float>(sun_e_[w]);
+              const float a = jv[w], b = jv1[w];
+              jv[w] = a > 0.0f && b > 0.0f ? a * std::pow(b / a, sa.ts) : a + (b - a) * sa.ts;
             }
-          }
-          if (segment != nullptr) {
-            // Multiple scattering of the segment: the tabulated source J_ms* at this point, in
-            // its local frame, attenuated by the scaled medium (the TMS split's L* part).
-            const double mus_c = std::clamp(mus, -1.0, 1.0);
-            const double mu2 = std::clamp((r * mu + t) / rr, -1.0, 1.0);
-            const double denom = std::sqrt(std::max(1e-12, (1.0 - mu2 * mu2) * (1.0 - mus_c * mus_c)));
-            const double cphi2 = std::clamp((nu - mu2 * mus_c) / denom, -1.0, 1.0);
-            // Log-linear in the sun angle, as the sky's own multiple scattering below: between
-            // twilight nodes 1 deg apart the sources fall ~e-fold, and linear interpolation put
-            // the fog between nodes ~10 % above the nodes' (docs/fog.md, "Limits").
-            const SunAzimuth sa = SunAzimuthAt(std::acos(mus_c), cphi2);
-            std::fill(jv.begin(), jv.end(), 0.0f);
-            if (sa.si != kNoSun) {
-              const RadialView rv = RadialViewAt(rr, mu2);
-              std::fill(jv1.begin(), jv1.end(), 0.0f);
-              Interpolate(jms_, rv, SunAzimuth{sa.si, sa.q0, 0.0f, sa.tq}, 1.0, jv.data());
-              if (sa.ts > 0.0f) {
-                Interpolate(jms_, rv, SunAzimuth{static_cast<uint16_t>(sa.si + 1), sa.q0, 0.0f, sa.tq}, 1.0, jv1.data());
-                for (size_t w = 0; w < nw_; ++w) {
-                  const float a = jv[w], b = jv1[w];
-                  jv[w] = a > 0.0f && b > 0.0f ? a * std::pow(b / a, sa.ts) : a + (b - a) * sa.ts;
-                }
-              }
-            }
-            std::fill(sst.begin(), sst.end(), 0.0f);
-            for (size_t c = 0; c < nc_; ++c) {
-              SigmaS(c, cell, true, st.data());
-              for (size_t w = 0; w < nw_; ++w) sst[w] += st[w];
-            }
-            for (size_t w = 0; w < nw_; ++w) seg_ms[w] += 0.5 * h * std::exp(-tau_star[w]) * sst[w] * jv[w];
           }
         }
-      }
-      if (ground) {
-        // Finish the optical depth to the ground and add the ground's first reflection.
-        const double tmid = 0.5 * (t_prev + length);
-        const double rmid = std::sqrt(r * r + 2.0 * r * mu * tmid + tmid * tmid);
-        SigmaT(rmid - R, false, st.data());
-        for (size_t w = 0; w < nw_; ++w) tau[w] += st[w] * (length - t_prev);
+        const float* sg = &ray.seg[p * nw_];
+        for (size_t w = 0; w < nw_; ++w) seg_ms[w] += sg[w] * jv[w];
       }
     }
-    if (ground) {
-      const double mus_g = (r * std::cos(ts) + std::max(0.0, length) * nu) / R;
+    if (ray.ground) {
+      // The ground's first reflection of the sun.
+      const double mus_g = (r * std::cos(ts) + std::max(0.0, ray.length) * nu) / R;
       if (mus_g > -0.5) {
         SunTransmittance(R, mus_g, false, tsun.data());
         for (size_t w = 0; w < nw_; ++w) {
-          acc[w] += static_cast<float>(std::exp(-tau[w]) * albedo_[w] / kPi * sun_e_[w] * std::max(0.0, mus_g)) * tsun[w];
+          acc[w] += static_cast<float>(ray.t_end[w] * albedo_[w] / kPi * sun_e_[w] * std::max(0.0, mus_g)) * tsun[w];
         }
       }
     }
