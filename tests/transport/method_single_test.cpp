@@ -57,6 +57,14 @@ TEST(MethodSingle, ExactOpticalDepth) {
         const double ref = -std::log(TransmittanceToSpace(m, h, zen * kDeg, w));
         EXPECT_NEAR(tau[w] / ref, 1.0, 1e-6) << "h " << h << " zenith " << zen << " wl " << w;
       }
+      // The all-wavelength walk (what the LUT renders use) gives each wavelength's value bit
+      // for bit, rays into the ground (0) included.
+      for (double z : {zen, 180.0 - zen}) {
+        std::vector<double> all;
+        TransmittanceToSpace(m, h, z * kDeg, &all);
+        ASSERT_EQ(all.size(), m.wavelengths());
+        for (size_t w = 0; w < m.wavelengths(); ++w) EXPECT_EQ(all[w], TransmittanceToSpace(m, h, z * kDeg, w)) << z << " " << w;
+      }
     }
   }
   std::vector<double> tau(m.wavelengths(), 0.0);

@@ -27,9 +27,13 @@ IntervalLocator::IntervalLocator(const std::vector<double>& x) : x_(x) {
   const size_t nb = 4 * x.size();
   scale_ = static_cast<double>(nb) / (x.back() - x.front());
   start_.resize(nb);
+  // The interval of each bucket's lower edge (FindInterval's answer, by one sweep: the rays of the
+  // deterministic sky build one locator per view ray), minus one: v in bucket b may round to
+  // just under the edge.
+  size_t i = 0;
   for (size_t b = 0; b < nb; ++b) {
-    // One interval below the edge's: v in bucket b may round to just under the edge.
-    const size_t i = FindInterval(x, x.front() + static_cast<double>(b) / scale_);
+    const double edge = x.front() + static_cast<double>(b) / scale_;
+    while (i + 2 < x.size() && x[i + 1] <= edge) ++i;
     start_[b] = static_cast<uint32_t>(i > 0 ? i - 1 : 0);
   }
 }

@@ -17,6 +17,16 @@ constexpr double kPi = std::numbers::pi;
 }
 
 double TransmittanceToSpace(const AtmosphereModel& m, double altitude_m, double zenith_rad, size_t wl) {
+  std::vector<double> t;
+  TransmittanceToSpace(m, altitude_m, zenith_rad, &t, wl);
+  return t[0];
+}
+
+void TransmittanceToSpace(const AtmosphereModel& m, double altitude_m, double zenith_rad, std::vector<double>* out,
+                          size_t only_wl) {
+  const size_t nw = only_wl == kAllWavelengths ? m.wavelengths() : 1;
+  const size_t w0 = only_wl == kAllWavelengths ? 0 : only_wl;
+  out->assign(nw, 0.0);
   const double r0 = m.bottom_radius_m + altitude_m;
   const double mu = std::cos(zenith_rad);
   // Ray-sphere geometry from r0 along mu: r(t)^2 = r0^2 + 2 r0 mu t + t^2.
@@ -24,7 +34,7 @@ double TransmittanceToSpace(const AtmosphereModel& m, double altitude_m, double 
   const double disc_ground = b * b - (r0 * r0 - m.bottom_radius_m * m.bottom_radius_m);
   if (mu < 0.0 && disc_ground >= 0.0) {
     const double t_ground = -b - std::sqrt(disc_ground);
-    if (t_ground >= 0.0) return 0.0;
+    if (t_ground >= 0.0) return;
   }
   const double length = -b + std::sqrt(std::max(0.0, b * b - (r0 * r0 - m.top_radius_m * m.top_radius_m)));
   // Composite 4-point Gauss-Legendre on pieces of <= 100 m (the profile's level spacing is
@@ -33,18 +43,21 @@ double TransmittanceToSpace(const AtmosphereModel& m, double altitude_m, double 
   static const double kW[2] = {0.6521451548625461, 0.3478548451374538};
   const int pieces = std::max(1, static_cast<int>(std::ceil(length / 100.0)));
   const double h = length / pieces;
-  double tau = 0.0;
+  // Every wavelength in one walk (the altitude located once per point); each wavelength's sum
+  // runs in the same order as alone, so the values do not depend on how many are asked for.
+  std::vector<double>& tau = *out;
   for (int p = 0; p < pieces; ++p) {
     const double c = (p + 0.5) * h;
     for (int k = 0; k < 2; ++k) {
       for (double sgn : {-1.0, 1.0}) {
         const double t = c + sgn * 0.5 * h * kX[k];
         const double r = std::sqrt(r0 * r0 + 2.0 * r0 * mu * t + t * t);
-        tau += kW[k] * 0.5 * h * m.Extinction(m.Locate(r - m.bottom_radius_m), wl);
+        const AtmosphereModel::Cell cell = m.Locate(r - m.bottom_radius_m);
+        for (size_t w = 0; w < nw; ++w) tau[w] += kW[k] * 0.5 * h * m.Extinction(cell, w0 + w);
       }
     }
   }
-  return std::exp(-tau);
+  for (double& v : tau) v = std::exp(-v);
 }
 
 SkyRenderResult RenderSky(const PathTracer& tracer, const SkyRenderSettings& s, const ProgressFn& progress) {
@@ -143,15 +156,15 @@ void FillTransmittanceAndSun(const AtmosphereModel& m, const std::vector<std::ar
     if (i < na) {
       const double zen = 180.0 * static_cast<double>(i) / std::max(1, s.transmittance_angles - 1);
       result->transmittance_zenith_deg[i] = zen;
-      for (size_t w = 0; w < nw; ++w) {
-        result->transmittance[i * nw + w] = TransmittanceToSpace(m, s.observer_altitude_m, zen * kPi / 180.0, w);
-      }
+      std::vector<double> t;
+      TransmittanceToSpace(m, s.observer_altitude_m, zen * kPi / 180.0, &t);
+      std::copy(t.begin(), t.end(), result->transmittance.begin() + static_cast<std::ptrdiff_t>(i * nw));
     } else {
       SkySlice& slice = result->slices[i - na];
       const double theta_s = slice.sun_zenith_deg * kPi / 180.0;
-      for (size_t w = 0; w < nw; ++w) {
-        slice.sun_irradiance[w] = m.sun.irradiance[w] * TransmittanceToSpace(m, s.observer_altitude_m, theta_s, w);
-      }
+      std::vector<double> t;
+      TransmittanceToSpace(m, s.observer_altitude_m, theta_s, &t);
+      for (size_t w = 0; w < nw; ++w) slice.sun_irradiance[w] = m.sun.irradiance[w] * t[w];
     }
   });
   for (SkySlice& slice : result->slices) {

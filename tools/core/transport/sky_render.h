@@ -66,5 +66,10 @@ SkyRenderResult RenderSkyDeterministic(const SkyMethod& method, const Atmosphere
 // Gauss-Legendre on 100 m of path) from a point at `altitude_m` along view zenith `zenith_rad`
 // to the top of the atmosphere, for wavelength wl; 0 if the ray hits the ground.
 double TransmittanceToSpace(const AtmosphereModel& model, double altitude_m, double zenith_rad, size_t wl);
+// The same at every wavelength of the model (or only at `only_wl`) into out, in one walk along
+// the ray; each value is the single-wavelength one, bit for bit.
+inline constexpr size_t kAllWavelengths = static_cast<size_t>(-1);
+void TransmittanceToSpace(const AtmosphereModel& model, double altitude_m, double zenith_rad, std::vector<double>* out,
+                          size_t only_wl = kAllWavelengths);
 
 }  // namespace skybake
