@@ -37,6 +37,7 @@ struct OrdersSettings {
   double loglin_from_deg = 90.0;  // sun-node intervals from here on: J blended log-linearly in the sun angle (> 180: never)
   double view_power = 2.0;   // view nodes: power of the node spacing in angle from the horizon
   bool normalise = true;     // kernel rows scaled to conserve energy
+  bool azimuth_even = true;  // azimuth blends even about the sun's plane (phi^2 near 0 and pi)
   bool early_tail = true;    // stop with the geometric tail once it is accurate to `tolerance`
   int max_orders = 40;
   double tolerance = 1e-3;
@@ -84,6 +85,9 @@ OrdersSettings SettingsFor(const SkyMethodOptions& o) {
   int rho_pct = 0;
   get("rho_cap_pct", &rho_pct);
   if (rho_pct > 0) s.rho_cap = rho_pct / 100.0;
+  int even = -1;
+  get("azimuth_even", &even);
+  if (even >= 0) s.azimuth_even = even != 0;
   int early = -1;
   get("early_tail", &early);
   if (early >= 0) s.early_tail = early != 0;
@@ -194,6 +198,27 @@ class OrdersMethod : public SkyMethod {
   void ViewIndex(double mu, double r, size_t* k0, size_t* k1, double* t) const;
   void SolveMultipleScattering(const ProgressFn& progress);
 
+  // Azimuth blend position of phi (0..pi, from the sun's plane): the lower node and the weight
+  // of the next one. The sky is even in the azimuth about the sun's vertical plane, so near
+  // phi = 0 and pi it goes as a + b phi^2 (a + b (pi - phi)^2): with `even`, the first and last
+  // intervals, and beyond the outer nodes (within pi / 2n of those planes), blend linearly in
+  // phi^2 ((pi - phi)^2), not in phi. Clamping there took the value of the node 11.25 deg from
+  // the sun for the sun's plane itself, under the forward lobe (hazed, sun 70 deg: -6 % at the
+  // horizon towards the sun; the output's blend is what matters: inside the table build the
+  // sources are smooth in azimuth and the change there is <= 0.01 %).
+  double AzimuthBlend(double phi, bool even, size_t* q0) const {
+    double fq = phi / kPi * s_.nphi - 0.5;
+    fq = std::clamp(fq, 0.0, static_cast<double>(s_.nphi - 1));
+    *q0 = std::min(static_cast<size_t>(fq), static_cast<size_t>(s_.nphi - 2));
+    double tq = fq - static_cast<double>(*q0);
+    if (even) {
+      auto sq = [](double x) { return x * x; };
+      const double p0 = (*q0 + 0.5) * kPi / s_.nphi, p1 = (*q0 + 1.5) * kPi / s_.nphi;
+      if (*q0 == 0) tq = (sq(phi) - sq(p0)) / (sq(p1) - sq(p0));
+      else if (*q0 + 2 == static_cast<size_t>(s_.nphi)) tq = 1.0 - (sq(kPi - phi) - sq(kPi - p1)) / (sq(kPi - p0) - sq(kPi - p1));
+    }
+    return tq;
+  }
   size_t Cell(size_t ri, size_t si, size_t k, size_t q) const {
     return ((ri * ns_ + si) * nu_ + k) * static_cast<size_t>(s_.nphi) + q;
   }
@@ -582,14 +607,12 @@ OrdersMethod::SunAzimuth OrdersMethod::SunAzimuthAt(double theta_s, double cos_p
     return sa;
   }
   const Lerp ls = Locate(sun_theta_rad_, theta_s);
-  const double phi = std::acos(std::clamp(cos_phi, -1.0, 1.0));
-  double fq = phi / kPi * s_.nphi - 0.5;
-  fq = std::clamp(fq, 0.0, static_cast<double>(s_.nphi - 1));
-  const size_t q0 = std::min(static_cast<size_t>(fq), static_cast<size_t>(s_.nphi - 2));
+  size_t q0;
+  const double tq = AzimuthBlend(std::acos(std::clamp(cos_phi, -1.0, 1.0)), s_.azimuth_even, &q0);
   sa.si = static_cast<uint16_t>(ls.i);
   sa.q0 = static_cast<uint16_t>(q0);
   sa.ts = static_cast<float>(ls.t);
-  sa.tq = static_cast<float>(fq - static_cast<double>(q0));
+  sa.tq = static_cast<float>(tq);
   return sa;
 }
 
@@ -1353,10 +1376,8 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
       size_t k0, k1;
       double tk;
       ViewIndex(mu, r, &k0, &k1, &tk);
-      double fq = std::acos(std::clamp(cphi, -1.0, 1.0)) / kPi * s_.nphi - 0.5;
-      fq = std::clamp(fq, 0.0, static_cast<double>(s_.nphi - 1));
-      const size_t q0 = std::min(static_cast<size_t>(fq), static_cast<size_t>(s_.nphi - 2));
-      const double tq = fq - static_cast<double>(q0);
+      size_t q0;
+      const double tq = AzimuthBlend(std::acos(std::clamp(cphi, -1.0, 1.0)), s_.azimuth_even, &q0);
       for (int ds = 0; ds < 2; ++ds) {
         float* dst = ds ? ms1.data() : ms0.data();
         const size_t si = ls.i + static_cast<size_t>(ds);
