@@ -82,6 +82,13 @@ TEST(MethodOrders, FirstOrderIsTheSingleScattering) {
 // reference's noise (1.5 %) the clear rows are mostly noise: against 1 % references on 35
 // directions and 48 wavelengths the noise-corrected RMS is 0.5 / 1.0 / 1.2 / 2.1 % (clear) and
 // 0.9 / 2.9 / 2.4 / 1.5 % (hazed) at sun 30 / 70 / 85 / 90 deg (docs/sky-methods.md "orders").
+// Re-measured after the second stop of 2026-11-23 (log-linear twilight sources in the build, the
+// azimuth blend even about the sun's plane): clear 1.6 / 3.1, 2.2 / 4.0, 1.4 / 2.2, 2.8 / 4.6 %;
+// hazed 1.6 / 2.8, 2.3 / 4.3, 3.1 / 5.8, 3.2 / 7.2 % (noise-corrected hazed 0.7 / 1.7 / 2.7 /
+// 2.5 %). Twilight, sun 94 deg (elevation -4, the issue's -10...0 deg range: target RMS 3 %),
+// 3 % references (twilight paths are expensive): clear 4.6 / 7.1 % (noise-corrected 3.4 %),
+// hazed 5.6 / 14.1 % (4.7 %; the max at 89.5 deg, 60 deg from the sun), orders brighter in 8 of
+// 10 directions; the chart's 91 directions with 2 % references give clear 1.7 % at -4 deg.
 // The bounds are those figures plus the reference's noise. The target (RMS 0.5 %, max
 // 2 %) is NOT met; what remains is the forward peak (truncation cone and kernel resolution:
 // docs/sky-methods.md "orders").
@@ -89,10 +96,10 @@ struct OrdersCase {
   double sza, target, max_rms, max_abs;
 };
 
-TEST(MethodOrders, AgainstThePathTracerFromDaylightToSunset) {
+TEST(MethodOrders, AgainstThePathTracerFromDaylightToTwilight) {
   const std::pair<const char*, std::vector<OrdersCase>> sets[] = {
-      {"clear", {{30.0, 0.015, 0.03, 0.05}, {70.0, 0.015, 0.03, 0.06}, {85.0, 0.015, 0.03, 0.07}, {90.0, 0.02, 0.045, 0.08}}},
-      {"hazed", {{30.0, 0.015, 0.03, 0.05}, {70.0, 0.015, 0.04, 0.07}, {85.0, 0.015, 0.045, 0.08}, {90.0, 0.02, 0.05, 0.09}}}};
+      {"clear", {{30.0, 0.015, 0.03, 0.05}, {70.0, 0.015, 0.03, 0.06}, {85.0, 0.015, 0.03, 0.07}, {90.0, 0.02, 0.045, 0.08}, {94.0, 0.03, 0.06, 0.10}}},
+      {"hazed", {{30.0, 0.015, 0.03, 0.05}, {70.0, 0.015, 0.04, 0.07}, {85.0, 0.015, 0.045, 0.08}, {90.0, 0.02, 0.05, 0.09}, {94.0, 0.03, 0.07, 0.18}}}};
   for (const auto& [atm, cases] : sets) {
     const TestScene sc = LoadTestScene(atm);
     SkyMethodOptions o;
