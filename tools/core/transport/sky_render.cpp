@@ -14,6 +14,8 @@ namespace skybake {
 
 namespace {
 constexpr double kPi = std::numbers::pi;
+void FillTransmittanceAndSun(const AtmosphereModel& m, const std::vector<std::array<double, 3>>& weights,
+                             const SkyRenderSettings& s, SkyRenderResult* result);
 }
 
 double TransmittanceToSpace(const AtmosphereModel& m, double altitude_m, double zenith_rad, size_t wl) {
@@ -62,21 +64,11 @@ void TransmittanceToSpace(const AtmosphereModel& m, double altitude_m, double ze
 
 SkyRenderResult RenderSky(const PathTracer& tracer, const SkyRenderSettings& s, const ProgressFn& progress) {
   const AtmosphereModel& m = tracer.model();
-  const size_t nw = m.wavelengths();
   SkyRenderResult result;
   const glm::dvec3 observer(0.0, 0.0, m.bottom_radius_m + s.observer_altitude_m);
   const SkyMapping& g = *s.mapping;
   const int W = g.width(), H = g.height();
   const size_t texels = static_cast<size_t>(W) * static_cast<size_t>(H);
-
-  // Transmittance table.
-  for (int a = 0; a < s.transmittance_angles; ++a) {
-    const double zen = 180.0 * a / std::max(1, s.transmittance_angles - 1);
-    result.transmittance_zenith_deg.push_back(zen);
-    for (size_t w = 0; w < nw; ++w) {
-      result.transmittance.push_back(TransmittanceToSpace(m, s.observer_altitude_m, zen * kPi / 180.0, w));
-    }
-  }
 
   // Texels to compute: one of each mirror pair.
   std::vector<size_t> work;
@@ -122,12 +114,6 @@ SkyRenderResult RenderSky(const PathTracer& tracer, const SkyRenderSettings& s, 
         if (progress && (n % 64 == 0 || n == total_tasks)) progress("sky radiance", static_cast<double>(n) / total_tasks);
       }
     });
-    // Direct sun at the observer (disk centre transmittance).
-    slice.sun_irradiance.resize(nw);
-    for (size_t w = 0; w < nw; ++w) {
-      slice.sun_irradiance[w] = m.sun.irradiance[w] * TransmittanceToSpace(m, s.observer_altitude_m, theta_s, w);
-      for (size_t c = 0; c < 3; ++c) slice.sun_xyz[c] += tracer.xyz_weights()[w][c] * slice.sun_irradiance[w];
-    }
     if (s.ambient) {
       const uint64_t stream = (uint64_t{1} << 40) + si;
       slice.ambient = tracer.Irradiance(observer, sun, stream);
@@ -136,6 +122,8 @@ SkyRenderResult RenderSky(const PathTracer& tracer, const SkyRenderSettings& s, 
     result.slices.push_back(std::move(slice));
   }
   result.total_paths = total_paths;
+  // Transmittance table and direct sun at the observer (disk centre transmittance).
+  FillTransmittanceAndSun(m, tracer.xyz_weights(), s, &result);
   return result;
 }
 
