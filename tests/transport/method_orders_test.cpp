@@ -53,11 +53,13 @@ const std::vector<std::array<double, 3>>& SkyDirs() {
 }  // namespace
 
 // With no multiple-scattering orders (max_orders 1) `orders` is its exact single scattering plus
-// the ground's reflection of the direct sun, which `single` computes with a different march
-// (altitude ladder, tabulated sun transmittance): they agree to the quadratures. Measured on the
-// hazed sky: <= 0.6 % at sun 30 deg (both within 1.5 % of the path tracer's first order), up to
-// 2.9 % at sun 80 deg near the horizon, where the two marches resolve the aerosol layer's
-// optical depth differently.
+// the ground's reflection of the direct sun. Against the path tracer's first order (max_order 1,
+// 0.5 % references) on the horizon band with the sun 10 deg high, where the sun's transmittance
+// changes e-fold over a few hundred metres of altitude: measured -0.1 to +0.4 % (hazed, 10 nm grid;
+// before the sun table followed the optical depth and blended its logarithm, 2026-11-23: +6 to +7 %
+// there, and +7.6 % at 87 deg with the sun at 85 deg). Against `single` (a different march:
+// altitude ladder, its own transmittance table): <= 0.5 % at sun 30 deg; at sun 80 deg `single`
+// medium is 2.4-3.6 % above both on the horizon band (measured), so that bound is 4 %.
 TEST(MethodOrders, FirstOrderIsTheSingleScattering) {
   const TestScene sc = LoadTestScene("hazed");
   SkyMethodOptions o;
@@ -65,9 +67,27 @@ TEST(MethodOrders, FirstOrderIsTheSingleScattering) {
   o.orders = 1;
   std::unique_ptr<SkyMethod> orders = MakeSkyMethod("orders", sc.model, o, {});
   std::unique_ptr<SkyMethod> single = MakeSkyMethod("single", sc.model, o, {});
-  for (const auto& [sza, bound] : {std::pair{30.0, 0.01}, std::pair{80.0, 0.035}}) {
+  for (const auto& [sza, bound] : {std::pair{30.0, 0.01}, std::pair{80.0, 0.04}}) {
     const std::vector<double> a = MethodY(sc, *orders, sza, SkyDirs()), b = MethodY(sc, *single, sza, SkyDirs());
-    for (size_t d = 0; d < a.size(); ++d) EXPECT_NEAR(a[d] / b[d], 1.0, bound) << "sun " << sza << " dir " << d;
+    for (size_t d = 0; d < a.size(); ++d) {
+      std::printf("orders / single, sun %.0f, dir %zu: %+.2f %%\n", sza, d, 100.0 * (a[d] / b[d] - 1.0));
+      EXPECT_NEAR(a[d] / b[d], 1.0, bound) << "sun " << sza << " dir " << d;
+    }
+  }
+  const std::vector<std::array<double, 3>> horizon = {Dir(88, 10), Dir(88, 90), Dir(88, 180)};
+  PathTracerSettings ps;
+  ps.target_relative_error = 0.005;
+  ps.min_paths = 1024;
+  ps.max_order = 1;
+  ps.max_paths = uint64_t{1} << 22;
+  PathTracer pt(sc.model, sc.weights, ps);
+  const std::vector<double> y = MethodY(sc, *orders, 80.0, horizon);
+  for (size_t d = 0; d < horizon.size(); ++d) {
+    const ColorEstimate e = pt.Radiance(glm::dvec3(0, 0, sc.model.bottom_radius_m + 1.0),
+                                        glm::dvec3(horizon[d][0], horizon[d][1], horizon[d][2]), DirectionFromAngles(80.0 * kDeg, 0), 900 + d);
+    std::printf("orders / path, first order, sun 80, 88 deg, dir %zu: %+.2f %% (path +- %.2f %%)\n", d,
+                100.0 * (y[d] / e.xyz[1] - 1.0), 100.0 * e.xyz_stderr[1] / e.xyz[1]);
+    EXPECT_NEAR(y[d] / e.xyz[1], 1.0, 0.015) << "dir " << d;
   }
 }
 
