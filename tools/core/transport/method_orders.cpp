@@ -1074,17 +1074,20 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
     }
     if (s_.kernel_sub > 0) {
       build_hat_kernel(r, mix_at, vmu, vsn, kernel);
+    } else {
+      for (size_t i = 0; i < nd; ++i) {
+        const size_t k = i / nphi, q = i % nphi;
+        for (size_t j = 0; j < nd; ++j) {
+          const size_t k2 = j / nphi, q2 = j % nphi;
+          const float wgt = static_cast<float>(vwidth[k2] * kPi / s_.nphi);
+          float* out = &kernel[(i * nd + j) * nw_];
+          const double cc = vmu[k] * vmu[k2], ss = vsn[k] * vsn[k2];
+          mix_at(cc + ss * cos_dphi[q * nphi + q2], wgt, out);
+          mix_at(cc + ss * cos_sphi[q * nphi + q2], wgt, out);
+        }
+      }
     }
     for (size_t i = 0; i < nd; ++i) {
-      const size_t k = i / nphi, q = i % nphi;
-      for (size_t j = 0; j < nd && s_.kernel_sub == 0; ++j) {
-        const size_t k2 = j / nphi, q2 = j % nphi;
-        const float wgt = static_cast<float>(vwidth[k2] * kPi / s_.nphi);
-        float* out = &kernel[(i * nd + j) * nw_];
-        const double cc = vmu[k] * vmu[k2], ss = vsn[k] * vsn[k2];
-        mix_at(cc + ss * cos_dphi[q * nphi + q2], wgt, out);
-        mix_at(cc + ss * cos_sphi[q * nphi + q2], wgt, out);
-      }
       if (s_.normalise) {
         // Energy conservation of the discrete phase integral: every row must sum to
         // sigma_s* (the phase function integrates to 1 over incoming directions); point
