@@ -126,6 +126,25 @@ OrdersSettings SettingsFor(const SkyMethodOptions& o) {
   return s;
 }
 
+// n altitudes in [0, H] uniform in a monotone s(h) with s(0) = 0 and s(H) = 1 (bisection to 1 mm;
+// the ends exactly 0 and H): the node placements that follow both altitude and optical depth.
+template <class S>
+std::vector<double> AltitudesUniformIn(const S& s_of, int n, double H) {
+  std::vector<double> h;
+  for (int i = 0; i < n; ++i) {
+    const double u = static_cast<double>(i) / (n - 1);
+    double lo = 0.0, hi = H;
+    if (i == 0) hi = 0.0;
+    if (i == n - 1) lo = H;
+    for (int it = 0; it < 60 && hi - lo > 1e-3; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (s_of(mid) < u ? lo : hi) = mid;
+    }
+    h.push_back(0.5 * (lo + hi));
+  }
+  return h;
+}
+
 // Linear interpolation position on a sorted grid: index of the lower node and weight of the upper.
 struct Lerp {
   size_t i = 0;
@@ -207,6 +226,8 @@ class OrdersMethod : public SkyMethod {
   }
   // View node k (0..nu-1, ascending mu) at radius r, its solid-angle width in mu.
   double ViewMu(size_t k, double r) const;
+  // The same placement at a fractional node index f within the set below (down) or above the horizon.
+  double ViewMuAt(bool down, double f, double r) const;
   double ViewWidth(size_t k, double r) const;
   // Fractional view index of mu at radius r (up and down parts are not interpolated across).
   void ViewIndex(double mu, double r, size_t* k0, size_t* k1, double* t) const;
@@ -435,16 +456,9 @@ void OrdersMethod::BuildSunTables() {
   // in docs/sky-methods.md for why it is not yet changed with it.
   const double tau_top = std::max(m_.VerticalOpticalDepth(0.0, H, 0), 1e-12);
   auto s_of = [&](double h) { return 0.5 * (m_.VerticalOpticalDepth(0.0, h, 0) / tau_top + std::sqrt(h / H)); };
+  for (double h : AltitudesUniformIn(s_of, nr, H)) sun_.r.push_back(R + h);
   for (int i = 0; i < nr; ++i) {
     const double u = static_cast<double>(i) / (nr - 1);
-    double lo = 0.0, hi = H;
-    if (i == 0) hi = 0.0;
-    if (i == nr - 1) lo = H;
-    for (int it = 0; it < 60 && hi - lo > 1e-3; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      (s_of(mid) < u ? lo : hi) = mid;
-    }
-    sun_.r.push_back(R + 0.5 * (lo + hi));
     sun_star_.r.push_back(R + H * u * u);
   }
   sun_.log_blend = true;
@@ -516,6 +530,7 @@ void OrdersMethod::BuildSunTables() {
         }
       }
     }
+    if (!tb->log_blend) continue;
     tb->lt.assign(tb->t.size(), 0.0f);
     tb->pos.assign(tb->t.size() / nw_, 1);
     for (size_t n = 0; n < tb->pos.size(); ++n) {
@@ -578,17 +593,7 @@ void OrdersMethod::BuildRadiusNodes() {
   const size_t wref = m_.wavelengths() / 2;
   const double tau_total = std::max(m_.VerticalOpticalDepth(0.0, H, wref), 1e-12);
   auto s_of = [&](double h) { return 0.5 * (m_.VerticalOpticalDepth(0.0, h, wref) / tau_total + std::pow(h / H, 0.4)); };
-  for (int i = 0; i < s_.nr; ++i) {
-    const double u = static_cast<double>(i) / (s_.nr - 1);
-    double lo = 0.0, hi = H;
-    if (i == 0) hi = 0.0;
-    if (i == s_.nr - 1) lo = H;
-    for (int it = 0; it < 60 && hi - lo > 1e-3; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      (s_of(mid) < u ? lo : hi) = mid;
-    }
-    radius_.push_back(R + 0.5 * (lo + hi));
-  }
+  for (double h : AltitudesUniformIn(s_of, s_.nr, H)) radius_.push_back(R + h);
   const double r_obs = R + std::clamp(observer_altitude_m_, 0.0, H * 0.999);
   auto it = std::lower_bound(radius_.begin(), radius_.end(), r_obs);
   if (it != radius_.end() && std::abs(*it - r_obs) < 1e-6) {
@@ -612,14 +617,15 @@ void OrdersMethod::BuildRadiusNodes() {
 // dense at the horizon, but the last up node was 29.5 deg from the zenith and the first down node
 // 43 deg from the nadir; under a tau-8 cloud the sky at 85 deg came out 22 % dark.
 double OrdersMethod::ViewMu(size_t k, double r) const {
+  const bool down = k < static_cast<size_t>(s_.ndn);
+  return ViewMuAt(down, static_cast<double>(down ? k : k - static_cast<size_t>(s_.ndn)), r);
+}
+
+double OrdersMethod::ViewMuAt(bool down, double f, double r) const {
   const double th = std::acos(HorizonMu(r));
   const double p = s_.view_power;
-  if (k < static_cast<size_t>(s_.ndn)) {
-    const double s = static_cast<double>(k) / (s_.ndn - 1);
-    return std::cos(th + (kPi - th) * std::pow(1.0 - s, p));
-  }
-  const double s = static_cast<double>(k - s_.ndn) / (s_.nup - 1);
-  return std::cos(th * (1.0 - std::pow(s, p)));
+  if (down) return std::cos(th + (kPi - th) * std::pow(1.0 - f / (s_.ndn - 1), p));
+  return std::cos(th * (1.0 - std::pow(f / (s_.nup - 1), p)));
 }
 
 double OrdersMethod::ViewWidth(size_t k, double r) const {
@@ -973,11 +979,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
   auto build_hat_kernel = [&](double r, const auto& mix_at, const std::vector<double>& vmu, const std::vector<double>& vsn,
                               float* kernel) {
     const int sub = s_.kernel_sub;
-    const double th = std::acos(HorizonMu(r)), pw = s_.view_power;
-    auto mu_of = [&](bool down, double f) {
-      if (down) return std::cos(th + (kPi - th) * std::pow(1.0 - f / (s_.ndn - 1), pw));
-      return std::cos(th * (1.0 - std::pow(f / (s_.nup - 1), pw)));
-    };
+    auto mu_of = [&](bool down, double f) { return ViewMuAt(down, f, r); };
     // Azimuth sub-samples: phi_a = (a + 1/2) u, u = pi / (nphi * 2 sub); the node azimuths are
     // (q + 1/2) pi / nphi = (2 sub q + sub + 1/2) u, so every phi_q -+ phi_a is a half-integer
     // multiple of u and the phase is evaluated once per multiple.
