@@ -44,6 +44,11 @@ struct OrdersSettings {
   // in the view-node index and in the azimuth blend) with n sub-intervals per view interval and
   // 2n per azimuth interval ("Scattering kernel" in docs/sky-methods.md).
   int kernel_sub = 0;
+  // The kernel applied in azimuthal cosine modes (the phase depends on the azimuth difference
+  // only: a circulant in the azimuth, plus the even blend's two end intervals as explicit
+  // columns); false: the (nd x nd) matrix, the slow and plain form the modal one is tested
+  // against ("Scattering kernel" in docs/sky-methods.md).
+  bool kernel_modal = true;
   int max_orders = 40;
   double tolerance = 1e-3;
   std::vector<double> sun_deg;  // sun zenith nodes
@@ -86,6 +91,9 @@ OrdersSettings SettingsFor(const SkyMethodOptions& o) {
   int ksub = -1;
   get("kernel_sub", &ksub);
   if (ksub >= 0) s.kernel_sub = ksub;
+  int modal = -1;
+  get("kernel_modal", &modal);
+  if (modal >= 0) s.kernel_modal = modal != 0;
 
   int loglin = 0;
   get("loglin_from_deg", &loglin);
@@ -1041,24 +1049,30 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
       }
     }
   };
-  auto build_kernel = [&](size_t ri, float* kernel) {
-    const double r = radius_[ri];
-    // The mixture phase x scattering coefficient on the cos grid at this radius.
+  // The mixture phase x scattering coefficient sum_c sigma_s*_c P*_c on the cos grid at a radius.
+  auto mixture = [&](size_t ri) {
     std::vector<float> mix(static_cast<size_t>(kPhaseGrid) * nw_, 0.0f), ssc(nw_);
     for (size_t c = 0; c < nc_; ++c) {
-      SigmaS(c, r - R, true, ssc.data());
+      SigmaS(c, radius_[ri] - R, true, ssc.data());
       for (int g = 0; g < kPhaseGrid; ++g) {
         for (size_t w = 0; w < nw_; ++w) mix[static_cast<size_t>(g) * nw_ + w] += ssc[w] * phase_star_[(c * kPhaseGrid + static_cast<size_t>(g)) * nw_ + w];
       }
     }
-    auto mix_at = [&](double mu, float scale, float* out) {
-      const double g = (std::clamp(mu, -1.0, 1.0) + 1.0) * 0.5 * (kPhaseGrid - 1);
-      const size_t gi = std::min(static_cast<size_t>(g), static_cast<size_t>(kPhaseGrid - 2));
-      const float t = static_cast<float>(g - static_cast<double>(gi));
-      const float* a = &mix[gi * nw_];
-      const float* b = &mix[(gi + 1) * nw_];
-      for (size_t w = 0; w < nw_; ++w) out[w] += scale * (a[w] + (b[w] - a[w]) * t);
-    };
+    return mix;
+  };
+  // scale x the mixture at cosine mu, accumulated into out[w].
+  auto mixture_at = [&](const std::vector<float>& mix, double mu, float scale, float* out) {
+    const double g = (std::clamp(mu, -1.0, 1.0) + 1.0) * 0.5 * (kPhaseGrid - 1);
+    const size_t gi = std::min(static_cast<size_t>(g), static_cast<size_t>(kPhaseGrid - 2));
+    const float t = static_cast<float>(g - static_cast<double>(gi));
+    const float* a = &mix[gi * nw_];
+    const float* b = &mix[(gi + 1) * nw_];
+    for (size_t w = 0; w < nw_; ++w) out[w] += scale * (a[w] + (b[w] - a[w]) * t);
+  };
+  auto build_kernel = [&](size_t ri, float* kernel) {
+    const double r = radius_[ri];
+    const std::vector<float> mix = mixture(ri);
+    auto mix_at = [&](double mu, float scale, float* out) { mixture_at(mix, mu, scale, out); };
     std::fill(kernel, kernel + kernel_floats, 0.0f);
     std::vector<double> cos_dphi(nphi * nphi), cos_sphi(nphi * nphi);
     for (size_t q = 0; q < nphi; ++q) {
@@ -1108,8 +1122,254 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
       }
     }
   };
+  // --- the kernel in azimuthal cosine modes. The phase depends on the azimuth only through the
+  // difference of the two azimuths, and the table is even about the sun's plane: on the circle of
+  // the 2 nphi azimuths theta_j = (j + 1/2) pi / nphi (the nodes and their mirror images) the
+  // kernel is a circulant c(q - j), and with L even its product is diagonal in the cosine modes
+  // cos(m theta), m < nphi (m = nphi vanishes at every node; m and 2 nphi - m fold onto each
+  // other): S_m(k2) = sum_q L(k2, q) cos(m theta_q), T_m(k) = sum_k2 G_m(k, k2) S_m(k2),
+  // J(k, q) = sum_m T_m(k) cos(m theta_q), with G_m = (m ? 2 : 1) / nphi sum_d c(d) cos(m d pi /
+  // nphi). Per radius and sun node nu^2 nphi + 2 nu nphi^2 products instead of (nu nphi)^2: 10x
+  // fewer for high (36 view x 24 azimuth nodes), whose matrix also did not fit in memory and was
+  // rebuilt every order (half of high's build). The basis kernel's azimuth hats are translates of
+  // one another except in the two end intervals, where the even blend (AzimuthBlend) departs from
+  // the linear one: that difference is kept as two explicit columns per view node,
+  // D_e(k, q, k2) applied to L(k2, q0) - L(k2, q0 + 1) (q0 = 0 and nphi - 2). The same values as
+  // the matrix to float rounding (test MethodOrders.ModalKernelIsTheMatrixKernel).
+  const bool modal = s_.kernel_modal;
+  const size_t nm = nphi;
+  std::vector<float> cos_mq(nm * nphi);
+  for (size_t m = 0; m < nm; ++m) {
+    for (size_t q = 0; q < nphi; ++q) cos_mq[m * nphi + q] = static_cast<float>(std::cos(static_cast<double>(m) * (q + 0.5) * kPi / s_.nphi));
+  }
+  const bool has_ends = s_.kernel_sub > 0 && s_.azimuth_even;
+  const size_t modal_floats = nm * nu_ * nu_ * nw_;               // G[((m * nu + k) * nu + k2) * nw + w]
+  const size_t end_floats = has_ends ? 2 * nu_ * nphi * nu_ * nw_ : 0;  // D[(((e * nu + k) * nphi + q) * nu + k2) * nw + w]
+  auto build_modal_kernel = [&](size_t ri, float* G, float* D) {
+    const double r = radius_[ri];
+    const std::vector<float> mix = mixture(ri);
+    const size_t N = 2 * nphi;
+    std::vector<double> vmu(nu_), vsn(nu_);
+    for (size_t k = 0; k < nu_; ++k) {
+      vmu[k] = ViewMu(k, r);
+      vsn[k] = std::sqrt(std::max(0.0, 1.0 - vmu[k] * vmu[k]));
+    }
+    std::vector<double> c(nu_ * nu_ * N * nw_, 0.0);  // c[((k * nu + k2) * N + d) * nw + w]
+    std::vector<double> dc(end_floats, 0.0);
+    std::vector<float> cd(nw_);
+    if (s_.kernel_sub == 0) {
+      // The phase at the nodes: c(d) = P(v_k . v_k2 at azimuth difference d pi / nphi) dmu_k2 pi / nphi.
+      for (size_t k = 0; k < nu_; ++k) {
+        for (size_t k2 = 0; k2 < nu_; ++k2) {
+          const double wgt = ViewWidth(k2, r) * kPi / s_.nphi;
+          for (size_t d = 0; d < N; ++d) {
+            std::fill(cd.begin(), cd.end(), 0.0f);
+            mixture_at(mix, vmu[k] * vmu[k2] + vsn[k] * vsn[k2] * std::cos(d * kPi / s_.nphi), 1.0f, cd.data());
+            double* o = &c[((k * nu_ + k2) * N + d) * nw_];
+            for (size_t w = 0; w < nw_; ++w) o[w] = wgt * cd[w];
+          }
+        }
+      }
+    } else {
+      // The basis kernel (build_hat_kernel's quadrature): the same view sub-intervals and azimuth
+      // sub-samples phi_a = (a + 1/2) u, u = pi / (2 sub nphi); the linear hat of node 0 is
+      // 1 - |e| / (2 sub) at phi_a - theta_0 = e u, so c(d) = u sum_e hat(e) P(cos((2 sub d - e) u)).
+      const int sub = s_.kernel_sub;
+      const size_t per = 2 * static_cast<size_t>(sub), na = nphi * per;
+      const double u = kPi / static_cast<double>(na);
+      std::vector<float> pm(2 * na * nw_);
+      std::vector<double> cosm(2 * na);
+      for (size_t m = 0; m < 2 * na; ++m) cosm[m] = std::cos((m + 0.5) * u);
+      // The end intervals' departure of the even blend from the linear one at each sub-sample.
+      struct EndSample {
+        size_t a, e;
+        double dw;  // (linear - even) weight of the interval's lower node
+      };
+      std::vector<EndSample> ends;
+      if (has_ends) {
+        for (size_t a = 0; a < na; ++a) {
+          size_t q0, q1;
+          const double te = AzimuthBlend((a + 0.5) * u, true, &q0), tl = AzimuthBlend((a + 0.5) * u, false, &q1);
+          if (te != tl) ends.push_back({a, q0 == 0 ? size_t{0} : size_t{1}, tl - te});
+        }
+      }
+      std::vector<double> hat(2 * per);
+      for (size_t i = 0; i < 2 * per; ++i) hat[i] = 1.0 - std::abs(static_cast<double>(i) - static_cast<double>(per) + 0.5) / static_cast<double>(per);
+      for (int set = 0; set < 2; ++set) {
+        const bool down = set == 0;
+        const int n = down ? s_.ndn : s_.nup;
+        const size_t base = down ? 0 : static_cast<size_t>(s_.ndn);
+        for (int kk = 0; kk + 1 < n; ++kk) {
+          for (int b = 0; b < sub; ++b) {
+            const double f0 = kk + static_cast<double>(b) / sub, f1 = kk + static_cast<double>(b + 1) / sub;
+            const double fm = 0.5 * (f0 + f1), tk = fm - kk;
+            const double m2 = ViewMuAt(down, fm, r), s2 = std::sqrt(std::max(0.0, 1.0 - m2 * m2));
+            const double dmu = std::abs(ViewMuAt(down, f1, r) - ViewMuAt(down, f0, r));
+            const size_t kn[2] = {base + static_cast<size_t>(kk), base + static_cast<size_t>(kk) + 1};
+            const double wk[2] = {(1.0 - tk) * dmu * u, tk * dmu * u};
+            for (size_t k = 0; k < nu_; ++k) {
+              const double cc = vmu[k] * m2, ss = vsn[k] * s2;
+              std::fill(pm.begin(), pm.end(), 0.0f);
+              for (size_t m = 0; m < 2 * na; ++m) mixture_at(mix, cc + ss * cosm[m], 1.0f, &pm[m * nw_]);
+              for (size_t d = 0; d < N; ++d) {
+                std::fill(cd.begin(), cd.end(), 0.0f);
+                for (size_t i = 0; i < 2 * per; ++i) {
+                  // phi_a - theta_0 = e u with e = i - per + 1/2; the difference theta_d - phi_a = (2 sub d - e) u.
+                  const double nn = std::abs(static_cast<double>(per * d) - (static_cast<double>(i) - static_cast<double>(per) + 0.5));
+                  const float* pv = &pm[static_cast<size_t>(nn - 0.5) * nw_];
+                  const float h = static_cast<float>(hat[i]);
+                  for (size_t w = 0; w < nw_; ++w) cd[w] += h * pv[w];
+                }
+                for (int x = 0; x < 2; ++x) {
+                  double* o = &c[((k * nu_ + kn[x]) * N + d) * nw_];
+                  for (size_t w = 0; w < nw_; ++w) o[w] += wk[x] * cd[w];
+                }
+              }
+              for (const EndSample& es : ends) {
+                for (size_t q = 0; q < nphi; ++q) {
+                  const long dlt = static_cast<long>(q * per + static_cast<size_t>(sub)) - static_cast<long>(es.a);
+                  const size_t md = static_cast<size_t>(dlt >= 1 ? dlt - 1 : -dlt), ms = q * per + static_cast<size_t>(sub) + es.a;
+                  for (int x = 0; x < 2; ++x) {
+                    double* o = &dc[(((es.e * nu_ + k) * nphi + q) * nu_ + kn[x]) * nw_];
+                    const double wgt = wk[x] * es.dw;
+                    for (size_t w = 0; w < nw_; ++w) o[w] += wgt * (pm[md * nw_ + w] + pm[ms * nw_ + w]);
+                  }
+                }
+              }
+            }
+          }
+        }
+      }
+    }
+    // Modes, with every row scaled to sum to sigma_s* (energy conservation, as the matrix's rows:
+    // a row's sum is sum_k2 sum_d c(d), the same for every azimuth; the end columns add nothing).
+    std::vector<double> cosd(nm * N);
+    for (size_t m = 0; m < nm; ++m) {
+      for (size_t d = 0; d < N; ++d) cosd[m * N + d] = std::cos(static_cast<double>(m * d) * kPi / s_.nphi);
+    }
+    std::vector<double> scale(nw_);
+    for (size_t k = 0; k < nu_; ++k) {
+      std::fill(scale.begin(), scale.end(), 0.0);
+      for (size_t k2 = 0; k2 < nu_; ++k2) {
+        for (size_t d = 0; d < N; ++d) {
+          const double* cv = &c[((k * nu_ + k2) * N + d) * nw_];
+          for (size_t w = 0; w < nw_; ++w) scale[w] += cv[w];
+        }
+      }
+      for (size_t w = 0; w < nw_; ++w) scale[w] = s_.normalise && scale[w] > 0.0 ? ssc_total[ri * nw_ + w] / scale[w] : 1.0;
+      for (size_t m = 0; m < nm; ++m) {
+        const double f = (m == 0 ? 1.0 : 2.0) / s_.nphi;
+        for (size_t k2 = 0; k2 < nu_; ++k2) {
+          float* g = &G[((m * nu_ + k) * nu_ + k2) * nw_];
+          for (size_t w = 0; w < nw_; ++w) {
+            double v = 0.0;
+            for (size_t d = 0; d < N; ++d) v += c[((k * nu_ + k2) * N + d) * nw_ + w] * cosd[m * N + d];
+            g[w] = static_cast<float>(f * scale[w] * v);
+          }
+        }
+      }
+      if (D != nullptr) {
+        for (size_t e = 0; e < 2; ++e) {
+          for (size_t q = 0; q < nphi; ++q) {
+            for (size_t k2 = 0; k2 < nu_; ++k2) {
+              const size_t o = (((e * nu_ + k) * nphi + q) * nu_ + k2) * nw_;
+              for (size_t w = 0; w < nw_; ++w) D[o + w] = static_cast<float>(scale[w] * dc[o + w]);
+            }
+          }
+        }
+      }
+    }
+  };
+  std::vector<float> modal_kernels, end_kernels;
+  if (modal) {
+    modal_kernels.resize(nr * modal_floats);
+    end_kernels.resize(nr * end_floats);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nr, 1), [&](const tbb::blocked_range<size_t>& rg) {
+      for (size_t ri = rg.begin(); ri != rg.end(); ++ri) {
+        build_modal_kernel(ri, &modal_kernels[ri * modal_floats], has_ends ? &end_kernels[ri * end_floats] : nullptr);
+      }
+    });
+  }
+  auto scatter_modal = [&](const std::vector<float>& Lin, std::vector<float>* Jout) {
+    // Tasks (radius, block of 4 sun nodes), as the matrix's: each G element loaded serves 4.
+    constexpr size_t kSunBlock = 4;
+    const size_t nsb = (ns_ + kSunBlock - 1) / kSunBlock;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nr * nsb, 1), [&](const tbb::blocked_range<size_t>& rg) {
+      std::vector<float> S(kSunBlock * nm * nu_ * nw_), T(kSunBlock * nu_ * nm * nw_), dL(kSunBlock * 2 * nu_ * nw_);
+      for (size_t idx = rg.begin(); idx != rg.end(); ++idx) {
+        const size_t ri = idx / nsb, s0 = (idx % nsb) * kSunBlock, s1 = std::min(ns_, s0 + kSunBlock), nb = s1 - s0;
+        const float* G = &modal_kernels[ri * modal_floats];
+        // Analysis: S[b][m][k2] = sum_q L(k2, q) cos(m theta_q); the end differences dL.
+        std::fill(S.begin(), S.end(), 0.0f);
+        for (size_t b = 0; b < nb; ++b) {
+          const float* lin = &Lin[((ri * ns_ + s0 + b) * nd) * nw_];
+          for (size_t k2 = 0; k2 < nu_; ++k2) {
+            for (size_t m = 0; m < nm; ++m) {
+              float* sv = &S[((b * nm + m) * nu_ + k2) * nw_];
+              for (size_t q = 0; q < nphi; ++q) {
+                const float cm = cos_mq[m * nphi + q];
+                const float* lv = &lin[(k2 * nphi + q) * nw_];
+                for (size_t w = 0; w < nw_; ++w) sv[w] += cm * lv[w];
+              }
+            }
+            if (has_ends) {
+              for (size_t e = 0; e < 2; ++e) {
+                const size_t q0 = e == 0 ? 0 : nphi - 2;
+                const float* l0 = &lin[(k2 * nphi + q0) * nw_];
+                float* dv = &dL[((b * 2 + e) * nu_ + k2) * nw_];
+                for (size_t w = 0; w < nw_; ++w) dv[w] = l0[w] - l0[nw_ + w];
+              }
+            }
+          }
+        }
+        // Modes: T[b][k][m] = sum_k2 G_m(k, k2) S[b][m][k2].
+        std::fill(T.begin(), T.end(), 0.0f);
+        for (size_t m = 0; m < nm; ++m) {
+          for (size_t k = 0; k < nu_; ++k) {
+            for (size_t k2 = 0; k2 < nu_; ++k2) {
+              const float* g = &G[((m * nu_ + k) * nu_ + k2) * nw_];
+              for (size_t b = 0; b < nb; ++b) {
+                const float* sv = &S[((b * nm + m) * nu_ + k2) * nw_];
+                float* tv = &T[((b * nu_ + k) * nm + m) * nw_];
+                for (size_t w = 0; w < nw_; ++w) tv[w] += g[w] * sv[w];
+              }
+            }
+          }
+        }
+        // Synthesis, the end columns, and J stored per unit sigma_s* (as the matrix's scatter).
+        std::vector<float> acc(nw_);
+        for (size_t b = 0; b < nb; ++b) {
+          float* jb = &(*Jout)[((ri * ns_ + s0 + b) * nd) * nw_];
+          for (size_t k = 0; k < nu_; ++k) {
+            for (size_t q = 0; q < nphi; ++q) {
+              std::fill(acc.begin(), acc.end(), 0.0f);
+              for (size_t m = 0; m < nm; ++m) {
+                const float cm = cos_mq[m * nphi + q];
+                const float* tv = &T[((b * nu_ + k) * nm + m) * nw_];
+                for (size_t w = 0; w < nw_; ++w) acc[w] += cm * tv[w];
+              }
+              if (has_ends) {
+                for (size_t e = 0; e < 2; ++e) {
+                  const float* Dv = &end_kernels[ri * end_floats + (((e * nu_ + k) * nphi + q) * nu_) * nw_];
+                  const float* dv = &dL[((b * 2 + e) * nu_) * nw_];
+                  for (size_t k2 = 0; k2 < nu_; ++k2) {
+                    for (size_t w = 0; w < nw_; ++w) acc[w] += Dv[k2 * nw_ + w] * dv[k2 * nw_ + w];
+                  }
+                }
+              }
+              float* jo = &jb[(k * nphi + q) * nw_];
+              for (size_t w = 0; w < nw_; ++w) {
+                const double st = ssc_total[ri * nw_ + w];
+                jo[w] = st > 0.0 ? static_cast<float>(acc[w] / st) : 0.0f;
+              }
+            }
+          }
+        }
+      }
+    });
+  };
   std::vector<float> kernels;
-  if (nr * kernel_floats * sizeof(float) <= (size_t{768} << 20)) {
+  if (!modal && nr * kernel_floats * sizeof(float) <= (size_t{768} << 20)) {
     kernels.resize(nr * kernel_floats);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nr, 1), [&](const tbb::blocked_range<size_t>& rg) {
       for (size_t ri = rg.begin(); ri != rg.end(); ++ri) build_kernel(ri, &kernels[ri * kernel_floats]);
@@ -1279,7 +1539,8 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
   };
   for (int order = 2; order <= s_.max_orders; ++order) {
     ReportProgress(progress, fmt::format("orders: order {}", order), 0.0);
-    scatter(L, &J);
+    if (modal) scatter_modal(L, &J);
+    else scatter(L, &J);
     for (size_t i = 0; i < jms_.size(); ++i) jms_[i] += J[i];
     transport(J, L, &Lnext);
     // Rotate: L = L_n, Lprev = L_{n-1}, Lnext = L_{n-2}.
