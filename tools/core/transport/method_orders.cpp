@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "io/error.h"
+#include "io/fast_exp.h"
 #include "io/interp.h"
 
 namespace skybake {
@@ -221,7 +222,12 @@ class OrdersMethod : public SkyMethod {
   // --- sun transmittance averaged over the solar disk, T(r, theta_s) per wavelength
   void BuildSunTables();
   // Disk-averaged sun transmittance at radius r and sun zenith cosine mu_s into out[w].
-  void SunTransmittance(double r, double mu_s, bool scaled, float* out) const;
+  void SunTransmittance(double r, double mu_s, bool scaled, float* out) const {
+    SunTransmittanceAt(SunRadius(r, scaled), mu_s, scaled, out);
+  }
+  // The same with the radius part of the lookup done once (a view ray's point, every direction).
+  Lerp SunRadius(double r, bool scaled) const { return Locate((scaled ? sun_star_ : sun_).loc, r); }
+  void SunTransmittanceAt(const Lerp& lr, double mu_s, bool scaled, float* out) const;
   // Optical depths (unscaled, truncated part) along a ray from r with cosine mu to the top;
   // false if it hits the ground.
   bool RayDepth(double r, double mu, std::vector<double>* tau, std::vector<double>* tau_f) const;
@@ -560,9 +566,8 @@ void OrdersMethod::BuildSunTables() {
 // optical depth; docs/sky-methods.md "Sun transmittance"). Where the nodes agree within 2 % the
 // linear blend is within 3e-5 of the logarithmic one and costs no exp; where one node is in the
 // Earth's full shadow (0) the blend stays linear.
-void OrdersMethod::SunTransmittance(double r, double mu_s, bool scaled, float* out) const {
+void OrdersMethod::SunTransmittanceAt(const Lerp& lr, double mu_s, bool scaled, float* out) const {
   const SunTable& tb = scaled ? sun_star_ : sun_;
-  const Lerp lr = Locate(tb.loc, r);
   const Lerp lt = Locate(sun_theta_loc_, std::acos(std::clamp(mu_s, -1.0, 1.0)) / kDeg);
   const size_t nt = sun_theta_deg_.size();
   const size_t n00 = lr.i * nt + lt.i, n10 = (lr.i + 1) * nt + lt.i;
@@ -581,7 +586,7 @@ void OrdersMethod::SunTransmittance(double r, double mu_s, bool scaled, float* o
       const float* l01 = &tb.lt[(n00 + 1) * nw_];
       const float* l10 = &tb.lt[n10 * nw_];
       const float* l11 = &tb.lt[(n10 + 1) * nw_];
-      for (size_t w = 0; w < nw_; ++w) out[w] = std::exp(w00 * l00[w] + w01 * l01[w] + w10 * l10[w] + w11 * l11[w]);
+      for (size_t w = 0; w < nw_; ++w) out[w] = ExpF(w00 * l00[w] + w01 * l01[w] + w10 * l10[w] + w11 * l11[w]);
       return;
     }
   }
@@ -1625,6 +1630,7 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
   // directions per call; it was two thirds of a clear-sky LUT's render).
   struct Point {
     double t = 0.0, rr = 0.0, mu2 = 0.0;
+    Lerp sun_r;  // the sun transmittance table's radius position
   };
   struct Ray {
     double mu = 2.0;  // none yet
@@ -1691,14 +1697,14 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
           for (size_t w = 0; w < nw_; ++w) tau_star[w] += st[w] * (t - t_prev);
         }
         t_prev = t;
-        ray.pts.push_back({t, rr, std::clamp((r * mu + t) / rr, -1.0, 1.0)});
+        ray.pts.push_back({t, rr, std::clamp((r * mu + t) / rr, -1.0, 1.0), SunRadius(rr, false)});
         const float hw = static_cast<float>(segment == nullptr || segment->single_scattering ? 0.5 * h : 0.0);
         const size_t e0 = ray.e.size();
         ray.e.resize(e0 + nc_ * nw_);
         for (size_t c = 0; c < nc_; ++c) {
           SigmaS(c, cell, false, st.data());
           // Single precision exp: the radiance is accumulated in float anyway.
-          for (size_t w = 0; w < nw_; ++w) ray.e[e0 + c * nw_ + w] = hw * std::exp(-static_cast<float>(tau[w])) * st[w];
+          for (size_t w = 0; w < nw_; ++w) ray.e[e0 + c * nw_ + w] = hw * ExpF(-static_cast<float>(tau[w])) * st[w];
         }
         if (segment != nullptr) {
           const size_t s0 = ray.seg.size();
@@ -1718,6 +1724,19 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
       SigmaT(rmid - R, false, st.data());
       for (size_t w = 0; w < nw_; ++w) ray.t_end[w] = static_cast<float>(std::exp(-(tau[w] + st[w] * (length - t_prev))));
     }
+    if (segment == nullptr) {
+      // Points behind an optical depth of ~88 at every wavelength (a grazing ray through a
+      // cloud deck) have a weight of exactly 0 (ExpF underflows): their single scattering adds
+      // nothing, so they are dropped (the same bytes, fewer sun lookups).
+      const size_t per = nc_ * nw_;
+      size_t keep = ray.pts.size();
+      while (keep > 0 && std::all_of(ray.e.begin() + static_cast<std::ptrdiff_t>((keep - 1) * per),
+                                     ray.e.begin() + static_cast<std::ptrdiff_t>(keep * per), [](float v) { return v == 0.0f; })) {
+        --keep;
+      }
+      ray.pts.resize(keep);
+      ray.e.resize(keep * per);
+    }
   };
 
   for (size_t d = 0; d < dirs.size(); ++d) {
@@ -1736,7 +1755,7 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
       const Point& pt = ray.pts[p];
       const double mus = (r * std::cos(ts) + pt.t * nu) / pt.rr;
       if (segment == nullptr || segment->single_scattering) {
-        SunTransmittance(pt.rr, mus, false, tsun.data());
+        SunTransmittanceAt(pt.sun_r, mus, false, tsun.data());
         const float* e = &ray.e[p * nc_ * nw_];
         std::fill(st.begin(), st.end(), 0.0f);
         for (size_t c = 0; c < nc_; ++c) {
