@@ -50,6 +50,12 @@ struct OrdersSettings {
   // columns); false: the (nd x nd) matrix, the slow and plain form the modal one is tested
   // against ("Scattering kernel" in docs/sky-methods.md).
   bool kernel_modal = true;
+  // A table ray's step weights J by the exact int T* sigma_t* dt = T*(t0) (1 - e^-dtau) times the
+  // single-scattering albedo at the step's point (conserves energy: the weights of a lossless
+  // medium sum to 1 - T*(end)); false: int T* dt exactly times sigma_s* at the point, which
+  // overweights a step whose point is denser than its mean (a thick cloud's orders then never
+  // converged: cloudy5, docs/sky-methods.md "Step weights").
+  bool step_albedo = true;
   int max_orders = 40;
   double tolerance = 1e-3;
   std::vector<double> sun_deg;  // sun zenith nodes
@@ -92,6 +98,9 @@ OrdersSettings SettingsFor(const SkyMethodOptions& o) {
   int ksub = -1;
   get("kernel_sub", &ksub);
   if (ksub >= 0) s.kernel_sub = ksub;
+  int salb = -1;
+  get("step_albedo", &salb);
+  if (salb >= 0) s.step_albedo = salb != 0;
   int modal = -1;
   get("kernel_modal", &modal);
   if (modal >= 0) s.kernel_modal = modal != 0;
@@ -834,10 +843,20 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
           SigmaS(c, rr - R, true, sc.data());
           for (size_t w = 0; w < nw_; ++w) f.ssc[m * nw_ + w] += sc[w];
         }
+        // The step's weight of J: int T* sigma_s* dt taken as sigma_s*/sigma_t* at the point times
+        // the exact int T* sigma_t* dt = T*(t0) (1 - e^-dtau) (step_albedo), or as sigma_s* at the
+        // point times the exact int T* dt (before 2026-11-23): where the point's extinction
+        // exceeds the step's mean (a dense cloud's steps) that weighted J by more than the light
+        // the step can scatter, and cloudy5's orders grew without end (docs/sky-methods.md).
+        SigmaT(rr - R, true, st.data());
         for (size_t w = 0; w < nw_; ++w) {
           const double tau0 = tau_at(t0, w), dtau = std::max(0.0, tau_at(t1, w) - tau0);
-          const double phi = dtau > 1e-6 ? -std::expm1(-dtau) / dtau : 1.0 - 0.5 * dtau;
-          f.wt[m * nw_ + w] = static_cast<float>(std::exp(-tau0) * h * phi);
+          if (s_.step_albedo && dtau > 1e-6 && st[w] > 0.0f) {
+            f.wt[m * nw_ + w] = static_cast<float>(-std::exp(-tau0) * std::expm1(-dtau) / st[w]);
+          } else {
+            const double phi = dtau > 1e-6 ? -std::expm1(-dtau) / dtau : 1.0 - 0.5 * dtau;
+            f.wt[m * nw_ + w] = static_cast<float>(std::exp(-tau0) * h * phi);
+          }
         }
       }
       f.trans_end.resize(nw_);
