@@ -146,6 +146,37 @@ TEST(MethodOrders, AgainstThePathTracerFromDaylightToTwilight) {
   }
 }
 
+// `high` against the path tracer at the daylight target (RMS <= 0.5 %, max <= 2 % outside
+// the aureole) on the hazed sky with the sun 30 and 70 deg from the zenith: ten directions
+// (SkyDirs), 0.5 % references, the 21-wavelength test grid. Measured here: noise-corrected RMS
+// 0.27 / 0.43 %, max 0.93 / 1.77 % (with 0.4 % references 0.36 / 0.51 %, 0.89 / 1.52 %); on the 48-wavelength grid with 35
+// directions 0.37 / 0.40 % RMS, 1.31 / 1.18 % max (docs/sky-methods.md "Measured accuracy"). The
+// RMS bound is the target plus this grid's 0.1 %; with the sun at 85 deg high is 1.9 % RMS (the
+// low-sun horizon, not asserted here).
+TEST(MethodOrders, HighAtTheDaylightTargetOnTheHazedSky) {
+  const TestScene sc = LoadTestScene("hazed");
+  SkyMethodOptions o;
+  o.quality = "high";
+  const std::unique_ptr<SkyMethod> orders = MakeSkyMethod("orders", sc.model, o, {});
+  for (double sza : {30.0, 70.0}) {
+    const std::vector<ColorEstimate> ref = PathY(sc, sza, SkyDirs(), 0.005);
+    const std::vector<double> y = MethodY(sc, *orders, sza, SkyDirs());
+    double ss = 0.0, noise = 0.0, worst = 0.0;
+    for (size_t d = 0; d < y.size(); ++d) {
+      const double e = y[d] / ref[d].xyz[1] - 1.0, sd = ref[d].xyz_stderr[1] / ref[d].xyz[1];
+      std::printf("high vs path, hazed sun %.0f deg, dir %zu: %+.2f %% (path +- %.2f %%)\n", sza, d, 100.0 * e, 100.0 * sd);
+      ss += e * e;
+      noise += sd * sd;
+      worst = std::max(worst, std::abs(e));
+    }
+    const double rms_corrected = std::sqrt(std::max(0.0, ss - noise) / static_cast<double>(y.size()));
+    std::printf("high vs path, hazed sun %.0f deg: RMS %.2f %% (noise-corrected), max %.2f %%\n", sza,
+                100.0 * rms_corrected, 100.0 * worst);
+    EXPECT_LT(rms_corrected, 0.006) << "sun " << sza;
+    EXPECT_LT(worst, 0.02) << "sun " << sza;
+  }
+}
+
 // The second order alone - `orders` with 2 orders against the path tracer counting scatterings up
 // to 2 - isolates the scattering kernel, which is where the hazed sky's error comes from
 // (docs/sky-methods.md "Scattering kernel"): hazed, sun 70 deg, five directions (the zenith, 10
