@@ -57,8 +57,8 @@ struct OrdersSettings {
   // converged: cloudy5, docs/sky-methods.md "Step weights").
   bool step_albedo = true;
   // Largest share of the total the geometric tail may have when taken early (see the stopping
-  // rule in SolveMultipleScattering; 0.1 before the energy-conserving step weights).
-  double tail_share_max = 0.3;
+  // rule in SolveMultipleScattering).
+  double tail_share_max = 0.1;
   int max_orders = 40;
   double tolerance = 1e-3;
   std::vector<double> sun_deg;  // sun zenith nodes
@@ -1595,12 +1595,12 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
     // Geometric tail once the ratio of successive orders has settled: the remaining orders sum
     // to L_n rho / (1 - rho), and an error d_rho in rho changes that by about
     // fraction_n d_rho / (1 - rho)^2 of the total; stop when that is below the tolerance and
-    // the tail is at most tail_share_max of the total, or at the last allowed order if the ratio
-    // has settled at all. The share limit: in a thick layer the ratio creeps up over many orders
-    // while each step of it is small (a tail taken at order 16 of a tau-8 cloud was 4-5 % short
-    // of the converged sum with the old step weights, hence 10 %); with the energy-conserving
-    // weights 30 % changes cloudy5 by <= 0.04 % (53 -> 35 orders), cloudy4 by <= 0.3 % (23 -> 20)
-    // and the tau-8 test layer by <= 0.5 % (40 -> 31 orders; docs/sky-methods.md "orders").
+    // the tail is at most tail_share_max (10 %) of the total, or at the last allowed order if the
+    // ratio has settled at all. The share limit: in a thick layer the ratio creeps up over many
+    // orders while each step of it is small (a tail taken at order 16 of a tau-8 cloud was 4-5 %
+    // short of the converged sum). 30 % was tried with the energy-conserving step weights: within
+    // 0.3 % on cloudy4/5 (5 and 18 orders fewer), but on the hazed sky with 24 azimuths and a 3 deg
+    // cone it took the tail at order 4-5 and the horizon came out 11 % dark (docs/sky-methods.md).
     const bool settled = ratio > 0.0 && ratio < 1.0 && prev_ratio > 0.0;
     const double tail_error =
         settled ? last_fraction_ * std::abs(ratio - prev_ratio) / ((1.0 - ratio) * (1.0 - ratio)) : 1.0;
