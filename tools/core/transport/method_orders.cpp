@@ -82,6 +82,11 @@ OrdersSettings SettingsFor(const SkyMethodOptions& o) {
     auto it = o.table_size.find(key);
     if (it != o.table_size.end()) *v = it->second;
   };
+  // A switch: 0 off, anything else on.
+  auto get_flag = [&](const char* key, bool* v) {
+    auto it = o.table_size.find(key);
+    if (it != o.table_size.end()) *v = it->second != 0;
+  };
   get("radius", &s.nr);
   get("view_up", &s.nup);
   get("view_down", &s.ndn);
@@ -91,9 +96,7 @@ OrdersSettings SettingsFor(const SkyMethodOptions& o) {
   int trunc = 0;
   get("truncation_deg", &trunc);
   if (trunc > 0) s.truncation_deg = trunc;
-  int norm = -1;
-  get("normalise", &norm);
-  if (norm >= 0) s.normalise = norm != 0;
+  get_flag("normalise", &s.normalise);
   int cap = 0;
   get("tau_cap", &cap);
   if (cap > 0) s.tau_cap = cap;
@@ -104,12 +107,8 @@ OrdersSettings SettingsFor(const SkyMethodOptions& o) {
   int tsp = 0;
   get("tail_share_pct", &tsp);
   if (tsp > 0) s.tail_share_max = tsp / 100.0;
-  int salb = -1;
-  get("step_albedo", &salb);
-  if (salb >= 0) s.step_albedo = salb != 0;
-  int modal = -1;
-  get("kernel_modal", &modal);
-  if (modal >= 0) s.kernel_modal = modal != 0;
+  get_flag("step_albedo", &s.step_albedo);
+  get_flag("kernel_modal", &s.kernel_modal);
 
   int loglin = 0;
   get("loglin_from_deg", &loglin);
@@ -120,12 +119,8 @@ OrdersSettings SettingsFor(const SkyMethodOptions& o) {
   int rho_pct = 0;
   get("rho_cap_pct", &rho_pct);
   if (rho_pct > 0) s.rho_cap = rho_pct / 100.0;
-  int even = -1;
-  get("azimuth_even", &even);
-  if (even >= 0) s.azimuth_even = even != 0;
-  int early = -1;
-  get("early_tail", &early);
-  if (early >= 0) s.early_tail = early != 0;
+  get_flag("azimuth_even", &s.azimuth_even);
+  get_flag("early_tail", &s.early_tail);
   if (o.view_steps > 0) s.nss = o.view_steps;
   if (o.orders > 0) s.max_orders = o.orders;
   if (o.order_tolerance > 0) s.tolerance = o.order_tolerance;
@@ -1006,80 +1001,6 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
     }
   }
   const size_t kernel_floats = nd * nd * nw_;
-  // The kernel integrated against the interpolation's basis: J(v_i) = int P(v_i . w) L(w) dw
-  // with L(w) = sum_j L_j h_j(w), h_j the weight the table lookup gives node j at w (linear in
-  // the view-node index f, and AzimuthBlend in the azimuth; both mirror halves of the azimuth).
-  // Integrated by the midpoint rule on n sub-intervals of every view interval (in f, so as dense
-  // as the nodes) and 2n of every azimuth interval. With the phase sampled at the nodes instead,
-  // a node stands for its whole cell: at the zenith node (a cap ~9 deg across) the aerosol lobe,
-  // ~5 deg wide after truncation at 3 deg, was counted as filling the cap, and the row's
-  // normalisation then took that excess from every other direction (hazed, sun 70 deg, order 2
-  // at the zenith -1.3 %, -2.4 % with 3 deg truncation; with this kernel +0.3 %).
-  auto build_hat_kernel = [&](double r, const auto& mix_at, const std::vector<double>& vmu, const std::vector<double>& vsn,
-                              float* kernel) {
-    const int sub = s_.kernel_sub;
-    auto mu_of = [&](bool down, double f) { return ViewMuAt(down, f, r); };
-    // Azimuth sub-samples: phi_a = (a + 1/2) u, u = pi / (nphi * 2 sub); the node azimuths are
-    // (q + 1/2) pi / nphi = (2 sub q + sub + 1/2) u, so every phi_q -+ phi_a is a half-integer
-    // multiple of u and the phase is evaluated once per multiple.
-    const size_t per = 2 * static_cast<size_t>(sub), na = nphi * per;
-    const double u = kPi / static_cast<double>(na);
-    std::vector<size_t> aq(na);
-    std::vector<float> atq(na);
-    for (size_t a = 0; a < na; ++a) {
-      size_t q0;
-      atq[a] = static_cast<float>(AzimuthBlend((a + 0.5) * u, s_.azimuth_even, &q0));
-      aq[a] = q0;
-    }
-    std::vector<double> cosm(2 * na);
-    for (size_t m = 0; m < 2 * na; ++m) cosm[m] = std::cos((m + 0.5) * u);
-    std::vector<float> pm(2 * na * nw_), row(nphi * nw_);
-    for (int set = 0; set < 2; ++set) {
-      const bool down = set == 0;
-      const int n = down ? s_.ndn : s_.nup;
-      const size_t base = down ? 0 : static_cast<size_t>(s_.ndn);
-      for (int kk = 0; kk + 1 < n; ++kk) {
-        for (int b = 0; b < sub; ++b) {
-          const double f0 = kk + static_cast<double>(b) / sub, f1 = kk + static_cast<double>(b + 1) / sub;
-          const double fm = 0.5 * (f0 + f1), tk = fm - kk;
-          const double m2 = mu_of(down, fm), s2 = std::sqrt(std::max(0.0, 1.0 - m2 * m2));
-          const double dmu = std::abs(mu_of(down, f1) - mu_of(down, f0));
-          const size_t kn[2] = {base + static_cast<size_t>(kk), base + static_cast<size_t>(kk) + 1};
-          const double wk[2] = {1.0 - tk, tk};
-          for (size_t k = 0; k < nu_; ++k) {
-            const double cc = vmu[k] * m2, ss = vsn[k] * s2;
-            std::fill(pm.begin(), pm.end(), 0.0f);
-            for (size_t m = 0; m < 2 * na; ++m) mix_at(cc + ss * cosm[m], 1.0f, &pm[m * nw_]);
-            for (size_t q = 0; q < nphi; ++q) {
-              // The row of output node (k, q) over the azimuth nodes, for this view sub-interval.
-              std::fill(row.begin(), row.end(), 0.0f);
-              const long qa = static_cast<long>(q * per + static_cast<size_t>(sub));
-              for (size_t a = 0; a < na; ++a) {
-                const long dlt = qa - static_cast<long>(a);
-                const size_t md = static_cast<size_t>(dlt >= 1 ? dlt - 1 : -dlt), ms = static_cast<size_t>(qa) + a;
-                const float* pd = &pm[md * nw_];
-                const float* ps = &pm[ms * nw_];
-                const float w1 = atq[a], w0 = 1.0f - w1;
-                float* r0 = &row[aq[a] * nw_];
-                float* r1 = r0 + nw_;
-                for (size_t w = 0; w < nw_; ++w) {
-                  const float v = pd[w] + ps[w];
-                  r0[w] += w0 * v;
-                  r1[w] += w1 * v;
-                }
-              }
-              for (int x = 0; x < 2; ++x) {
-                const float wgt = static_cast<float>(wk[x] * dmu * u);
-                if (wgt == 0.0f) continue;
-                float* out = &kernel[((k * nphi + q) * nd + kn[x] * nphi) * nw_];
-                for (size_t e = 0; e < nphi * nw_; ++e) out[e] += wgt * row[e];
-              }
-            }
-          }
-        }
-      }
-    }
-  };
   // The mixture phase x scattering coefficient sum_c sigma_s*_c P*_c on the cos grid at a radius.
   auto mixture = [&](size_t ri) {
     std::vector<float> mix(static_cast<size_t>(kPhaseGrid) * nw_, 0.0f), ssc(nw_);
@@ -1099,6 +1020,93 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
     const float* a = &mix[gi * nw_];
     const float* b = &mix[(gi + 1) * nw_];
     for (size_t w = 0; w < nw_; ++w) out[w] += scale * (a[w] + (b[w] - a[w]) * t);
+  };
+  // The basis kernel's quadrature (both forms, matrix and modal): for every view sub-interval
+  // (kernel_sub per view interval, midpoint rule in the view-node index f) and every output view
+  // node k, the mixture phase at the 2 na azimuth offsets (m + 1/2) u, u = pi / (2 sub nphi),
+  // into pm[m * nw + w]; then fn(k, kn, wk, dmu, pm) with kn the sub-interval's two view nodes, wk
+  // their hat weights at its midpoint and dmu its width in mu. The node azimuths are
+  // (q + 1/2) pi / nphi = (2 sub q + sub + 1/2) u, so every phi_q -+ phi_a is a half-integer
+  // multiple of u and the phase is evaluated once per multiple.
+  auto for_each_view_subsample = [&](double r, const std::vector<float>& mix, const std::vector<double>& vmu,
+                                     const std::vector<double>& vsn, const auto& fn) {
+    const int sub = s_.kernel_sub;
+    const size_t na = nphi * 2 * static_cast<size_t>(sub);
+    const double u = kPi / static_cast<double>(na);
+    std::vector<double> cosm(2 * na);
+    for (size_t m = 0; m < 2 * na; ++m) cosm[m] = std::cos((m + 0.5) * u);
+    std::vector<float> pm(2 * na * nw_);
+    for (int set = 0; set < 2; ++set) {
+      const bool down = set == 0;
+      const int n = down ? s_.ndn : s_.nup;
+      const size_t base = down ? 0 : static_cast<size_t>(s_.ndn);
+      for (int kk = 0; kk + 1 < n; ++kk) {
+        for (int b = 0; b < sub; ++b) {
+          const double f0 = kk + static_cast<double>(b) / sub, f1 = kk + static_cast<double>(b + 1) / sub;
+          const double fm = 0.5 * (f0 + f1), tk = fm - kk;
+          const double m2 = ViewMuAt(down, fm, r), s2 = std::sqrt(std::max(0.0, 1.0 - m2 * m2));
+          const double dmu = std::abs(ViewMuAt(down, f1, r) - ViewMuAt(down, f0, r));
+          const size_t kn[2] = {base + static_cast<size_t>(kk), base + static_cast<size_t>(kk) + 1};
+          const double wk[2] = {1.0 - tk, tk};
+          for (size_t k = 0; k < nu_; ++k) {
+            const double cc = vmu[k] * m2, ss = vsn[k] * s2;
+            std::fill(pm.begin(), pm.end(), 0.0f);
+            for (size_t m = 0; m < 2 * na; ++m) mixture_at(mix, cc + ss * cosm[m], 1.0f, &pm[m * nw_]);
+            fn(k, kn, wk, dmu, pm);
+          }
+        }
+      }
+    }
+  };
+  // The kernel integrated against the interpolation's basis: J(v_i) = int P(v_i . w) L(w) dw
+  // with L(w) = sum_j L_j h_j(w), h_j the weight the table lookup gives node j at w (linear in
+  // the view-node index f, and AzimuthBlend in the azimuth; both mirror halves of the azimuth).
+  // Integrated by the midpoint rule on n sub-intervals of every view interval (in f, so as dense
+  // as the nodes) and 2n of every azimuth interval. With the phase sampled at the nodes instead,
+  // a node stands for its whole cell: at the zenith node (a cap ~9 deg across) the aerosol lobe,
+  // ~5 deg wide after truncation at 3 deg, was counted as filling the cap, and the row's
+  // normalisation then took that excess from every other direction (hazed, sun 70 deg, order 2
+  // at the zenith -1.3 %, -2.4 % with 3 deg truncation; with this kernel +0.3 %).
+  auto build_hat_kernel = [&](double r, const std::vector<float>& mix, const std::vector<double>& vmu,
+                              const std::vector<double>& vsn, float* kernel) {
+    const int sub = s_.kernel_sub;
+    const size_t per = 2 * static_cast<size_t>(sub), na = nphi * per;
+    const double u = kPi / static_cast<double>(na);
+    std::vector<size_t> aq(na);
+    std::vector<float> atq(na);
+    for (size_t a = 0; a < na; ++a) {
+      size_t q0;
+      atq[a] = static_cast<float>(AzimuthBlend((a + 0.5) * u, s_.azimuth_even, &q0));
+      aq[a] = q0;
+    }
+    std::vector<float> row(nphi * nw_);
+    for_each_view_subsample(r, mix, vmu, vsn, [&](size_t k, const size_t* kn, const double* wk, double dmu, const std::vector<float>& pm) {
+      for (size_t q = 0; q < nphi; ++q) {
+        // The row of output node (k, q) over the azimuth nodes, for this view sub-interval.
+        std::fill(row.begin(), row.end(), 0.0f);
+        const long qa = static_cast<long>(q * per + static_cast<size_t>(sub));
+        for (size_t a = 0; a < na; ++a) {
+          const long dlt = qa - static_cast<long>(a);
+          const size_t md = static_cast<size_t>(dlt >= 1 ? dlt - 1 : -dlt), ms = static_cast<size_t>(qa) + a;
+          const float* pd = &pm[md * nw_];
+          const float* ps = &pm[ms * nw_];
+          const float w1 = atq[a], w0 = 1.0f - w1;
+          float* r0 = &row[aq[a] * nw_];
+          float* r1 = r0 + nw_;
+          for (size_t w = 0; w < nw_; ++w) {
+            const float v = pd[w] + ps[w];
+            r0[w] += w0 * v;
+            r1[w] += w1 * v;
+          }
+        }
+        for (int x = 0; x < 2; ++x) {
+          const float wgt = static_cast<float>(wk[x] * dmu * u);
+          if (wgt == 0.0f) continue;
+          float* out = &kernel[((k * nphi + q) * nd + kn[x] * nphi) * nw_];
+          for (size_t e = 0; e < nphi * nw_; ++e) out[e] += wgt * row[e];
+        }
+      }
+    });
   };
   auto build_kernel = [&](size_t ri, float* kernel) {
     const double r = radius_[ri];
@@ -1120,7 +1128,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
       vwidth[k] = ViewWidth(k, r);
     }
     if (s_.kernel_sub > 0) {
-      build_hat_kernel(r, mix_at, vmu, vsn, kernel);
+      build_hat_kernel(r, mix, vmu, vsn, kernel);
     } else {
       for (size_t i = 0; i < nd; ++i) {
         const size_t k = i / nphi, q = i % nphi;
@@ -1202,15 +1210,12 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
         }
       }
     } else {
-      // The basis kernel (build_hat_kernel's quadrature): the same view sub-intervals and azimuth
+      // The basis kernel (for_each_view_subsample's quadrature, as the matrix's): azimuth
       // sub-samples phi_a = (a + 1/2) u, u = pi / (2 sub nphi); the linear hat of node 0 is
       // 1 - |e| / (2 sub) at phi_a - theta_0 = e u, so c(d) = u sum_e hat(e) P(cos((2 sub d - e) u)).
       const int sub = s_.kernel_sub;
       const size_t per = 2 * static_cast<size_t>(sub), na = nphi * per;
       const double u = kPi / static_cast<double>(na);
-      std::vector<float> pm(2 * na * nw_);
-      std::vector<double> cosm(2 * na);
-      for (size_t m = 0; m < 2 * na; ++m) cosm[m] = std::cos((m + 0.5) * u);
       // The end intervals' departure of the even blend from the linear one at each sub-sample.
       struct EndSample {
         size_t a, e;
@@ -1226,51 +1231,34 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
       }
       std::vector<double> hat(2 * per);
       for (size_t i = 0; i < 2 * per; ++i) hat[i] = 1.0 - std::abs(static_cast<double>(i) - static_cast<double>(per) + 0.5) / static_cast<double>(per);
-      for (int set = 0; set < 2; ++set) {
-        const bool down = set == 0;
-        const int n = down ? s_.ndn : s_.nup;
-        const size_t base = down ? 0 : static_cast<size_t>(s_.ndn);
-        for (int kk = 0; kk + 1 < n; ++kk) {
-          for (int b = 0; b < sub; ++b) {
-            const double f0 = kk + static_cast<double>(b) / sub, f1 = kk + static_cast<double>(b + 1) / sub;
-            const double fm = 0.5 * (f0 + f1), tk = fm - kk;
-            const double m2 = ViewMuAt(down, fm, r), s2 = std::sqrt(std::max(0.0, 1.0 - m2 * m2));
-            const double dmu = std::abs(ViewMuAt(down, f1, r) - ViewMuAt(down, f0, r));
-            const size_t kn[2] = {base + static_cast<size_t>(kk), base + static_cast<size_t>(kk) + 1};
-            const double wk[2] = {(1.0 - tk) * dmu * u, tk * dmu * u};
-            for (size_t k = 0; k < nu_; ++k) {
-              const double cc = vmu[k] * m2, ss = vsn[k] * s2;
-              std::fill(pm.begin(), pm.end(), 0.0f);
-              for (size_t m = 0; m < 2 * na; ++m) mixture_at(mix, cc + ss * cosm[m], 1.0f, &pm[m * nw_]);
-              for (size_t d = 0; d < N; ++d) {
-                std::fill(cd.begin(), cd.end(), 0.0f);
-                for (size_t i = 0; i < 2 * per; ++i) {
-                  // phi_a - theta_0 = e u with e = i - per + 1/2; the difference theta_d - phi_a = (2 sub d - e) u.
-                  const double nn = std::abs(static_cast<double>(per * d) - (static_cast<double>(i) - static_cast<double>(per) + 0.5));
-                  const float* pv = &pm[static_cast<size_t>(nn - 0.5) * nw_];
-                  const float h = static_cast<float>(hat[i]);
-                  for (size_t w = 0; w < nw_; ++w) cd[w] += h * pv[w];
-                }
-                for (int x = 0; x < 2; ++x) {
-                  double* o = &c[((k * nu_ + kn[x]) * N + d) * nw_];
-                  for (size_t w = 0; w < nw_; ++w) o[w] += wk[x] * cd[w];
-                }
-              }
-              for (const EndSample& es : ends) {
-                for (size_t q = 0; q < nphi; ++q) {
-                  const long dlt = static_cast<long>(q * per + static_cast<size_t>(sub)) - static_cast<long>(es.a);
-                  const size_t md = static_cast<size_t>(dlt >= 1 ? dlt - 1 : -dlt), ms = q * per + static_cast<size_t>(sub) + es.a;
-                  for (int x = 0; x < 2; ++x) {
-                    double* o = &dc[(((es.e * nu_ + k) * nphi + q) * nu_ + kn[x]) * nw_];
-                    const double wgt = wk[x] * es.dw;
-                    for (size_t w = 0; w < nw_; ++w) o[w] += wgt * (pm[md * nw_ + w] + pm[ms * nw_ + w]);
-                  }
-                }
-              }
+      for_each_view_subsample(r, mix, vmu, vsn, [&](size_t k, const size_t* kn, const double* wk_hat, double dmu, const std::vector<float>& pm) {
+        const double wk[2] = {wk_hat[0] * dmu * u, wk_hat[1] * dmu * u};
+        for (size_t d = 0; d < N; ++d) {
+          std::fill(cd.begin(), cd.end(), 0.0f);
+          for (size_t i = 0; i < 2 * per; ++i) {
+            // phi_a - theta_0 = e u with e = i - per + 1/2; the difference theta_d - phi_a = (2 sub d - e) u.
+            const double nn = std::abs(static_cast<double>(per * d) - (static_cast<double>(i) - static_cast<double>(per) + 0.5));
+            const float* pv = &pm[static_cast<size_t>(nn - 0.5) * nw_];
+            const float h = static_cast<float>(hat[i]);
+            for (size_t w = 0; w < nw_; ++w) cd[w] += h * pv[w];
+          }
+          for (int x = 0; x < 2; ++x) {
+            double* o = &c[((k * nu_ + kn[x]) * N + d) * nw_];
+            for (size_t w = 0; w < nw_; ++w) o[w] += wk[x] * cd[w];
+          }
+        }
+        for (const EndSample& es : ends) {
+          for (size_t q = 0; q < nphi; ++q) {
+            const long dlt = static_cast<long>(q * per + static_cast<size_t>(sub)) - static_cast<long>(es.a);
+            const size_t md = static_cast<size_t>(dlt >= 1 ? dlt - 1 : -dlt), ms = q * per + static_cast<size_t>(sub) + es.a;
+            for (int x = 0; x < 2; ++x) {
+              double* o = &dc[(((es.e * nu_ + k) * nphi + q) * nu_ + kn[x]) * nw_];
+              const double wgt = wk[x] * es.dw;
+              for (size_t w = 0; w < nw_; ++w) o[w] += wgt * (pm[md * nw_ + w] + pm[ms * nw_ + w]);
             }
           }
         }
-      }
+      });
     }
     // Modes, with every row scaled to sum to sigma_s* (energy conservation, as the matrix's rows:
     // a row's sum is sum_k2 sum_d c(d), the same for every azimuth; the end columns add nothing).
