@@ -1021,6 +1021,19 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
     const float* b = &mix[(gi + 1) * nw_];
     for (size_t w = 0; w < nw_; ++w) out[w] += scale * (a[w] + (b[w] - a[w]) * t);
   };
+  // The view nodes at a radius: cosine, sine and trapezoid width in mu (both kernel builders).
+  struct ViewNodes {
+    std::vector<double> mu, sn, width;
+  };
+  auto view_nodes = [&](double r) {
+    ViewNodes v{std::vector<double>(nu_), std::vector<double>(nu_), std::vector<double>(nu_)};
+    for (size_t k = 0; k < nu_; ++k) {
+      v.mu[k] = ViewMu(k, r);
+      v.sn[k] = std::sqrt(std::max(0.0, 1.0 - v.mu[k] * v.mu[k]));
+      v.width[k] = ViewWidth(k, r);
+    }
+    return v;
+  };
   // The basis kernel's quadrature (both forms, matrix and modal): for every view sub-interval
   // (kernel_sub per view interval, midpoint rule in the view-node index f) and every output view
   // node k, the mixture phase at the 2 na azimuth offsets (m + 1/2) u, u = pi / (2 sub nphi),
@@ -1121,12 +1134,8 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
         cos_sphi[q * nphi + q2] = std::cos(phi + phi2);
       }
     }
-    std::vector<double> vmu(nu_), vsn(nu_), vwidth(nu_);
-    for (size_t k = 0; k < nu_; ++k) {
-      vmu[k] = ViewMu(k, r);
-      vsn[k] = std::sqrt(std::max(0.0, 1.0 - vmu[k] * vmu[k]));
-      vwidth[k] = ViewWidth(k, r);
-    }
+    const ViewNodes vn = view_nodes(r);
+    const std::vector<double>&vmu = vn.mu, &vsn = vn.sn, &vwidth = vn.width;
     if (s_.kernel_sub > 0) {
       build_hat_kernel(r, mix, vmu, vsn, kernel);
     } else {
@@ -1188,11 +1197,8 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
     const double r = radius_[ri];
     const std::vector<float> mix = mixture(ri);
     const size_t N = 2 * nphi;
-    std::vector<double> vmu(nu_), vsn(nu_);
-    for (size_t k = 0; k < nu_; ++k) {
-      vmu[k] = ViewMu(k, r);
-      vsn[k] = std::sqrt(std::max(0.0, 1.0 - vmu[k] * vmu[k]));
-    }
+    const ViewNodes vn = view_nodes(r);
+    const std::vector<double>&vmu = vn.mu, &vsn = vn.sn;
     std::vector<double> c(nu_ * nu_ * N * nw_, 0.0);  // c[((k * nu + k2) * N + d) * nw + w]
     std::vector<double> dc(end_floats, 0.0);
     std::vector<float> cd(nw_);
@@ -1200,7 +1206,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
       // The phase at the nodes: c(d) = P(v_k . v_k2 at azimuth difference d pi / nphi) dmu_k2 pi / nphi.
       for (size_t k = 0; k < nu_; ++k) {
         for (size_t k2 = 0; k2 < nu_; ++k2) {
-          const double wgt = ViewWidth(k2, r) * kPi / s_.nphi;
+          const double wgt = vn.width[k2] * kPi / s_.nphi;
           for (size_t d = 0; d < N; ++d) {
             std::fill(cd.begin(), cd.end(), 0.0f);
             mixture_at(mix, vmu[k] * vmu[k2] + vsn[k] * vsn[k2] * std::cos(d * kPi / s_.nphi), 1.0f, cd.data());
@@ -1314,7 +1320,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
     constexpr size_t kSunBlock = 4;
     const size_t nsb = (ns_ + kSunBlock - 1) / kSunBlock;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nr * nsb, 1), [&](const tbb::blocked_range<size_t>& rg) {
-      std::vector<float> S(kSunBlock * nm * nu_ * nw_), T(kSunBlock * nu_ * nm * nw_), dL(kSunBlock * 2 * nu_ * nw_);
+      std::vector<float> S(kSunBlock * nm * nu_ * nw_), T(kSunBlock * nu_ * nm * nw_), dL(kSunBlock * 2 * nu_ * nw_), acc(nw_);
       for (size_t idx = rg.begin(); idx != rg.end(); ++idx) {
         const size_t ri = idx / nsb, s0 = (idx % nsb) * kSunBlock, s1 = std::min(ns_, s0 + kSunBlock), nb = s1 - s0;
         const float* G = &modal_kernels[ri * modal_floats];
@@ -1356,7 +1362,6 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
           }
         }
         // Synthesis, the end columns, and J stored per unit sigma_s* (as the matrix's scatter).
-        std::vector<float> acc(nw_);
         for (size_t b = 0; b < nb; ++b) {
           float* jb = &(*Jout)[((ri * ns_ + s0 + b) * nd) * nw_];
           for (size_t k = 0; k < nu_; ++k) {
