@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <map>
+#include <memory>
 #include <mutex>
 #include <numbers>
 
@@ -349,6 +351,44 @@ class OrdersMethod : public SkyMethod {
   int orders_done_ = 0;
   bool tail_ = false;
   double last_fraction_ = 0.0;
+
+  // A view ray's sun-independent part (Render).
+  struct ViewPoint {
+    double t = 0.0, rr = 0.0, mu2 = 0.0;
+    Lerp sun_r;  // the sun transmittance table's radius position
+  };
+  struct ViewRay {
+    double mu = 2.0;  // none yet
+    double length = 0.0;
+    bool ground = false;
+    std::vector<ViewPoint> pts;
+    std::vector<float> e;      // [(p * nc + c) * nw + w]: half-step x T(0, t_p) x sigma_s,c (single scattering weight)
+    std::vector<float> seg;    // [p * nw + w]: half-step x T*(0, t_p) x sigma_s* (segments' multiple scattering)
+    std::vector<float> t_end;  // [w] transmittance to the ray's end (the ground)
+  };
+  // The whole view ray (no segment) from the observer altitude along mu: built by `build` on the
+  // first request and kept, up to kMaxCachedRays rays (then built anew each time). A ray depends
+  // on (altitude, mu) only, so a cached one is the same bytes as a new one, whichever thread
+  // built it first. The LUT render's 16 ambient rings are the same in each of its 64 sun slices
+  // (its rows are not: the GT7 mapping's view zenith follows the sun); keeping them saves
+  // 0.2-0.4 s of a 32x128 LUT at 48 wavelengths (docs/benchmarks.md).
+  template <class Build>
+  std::shared_ptr<const ViewRay> CachedViewRay(double altitude_m, double mu, Build&& build) const {
+    const std::pair<double, double> key{altitude_m, mu};
+    {
+      std::lock_guard<std::mutex> lock(ray_mutex_);
+      auto it = rays_.find(key);
+      if (it != rays_.end()) return it->second;
+    }
+    auto ray = std::make_shared<ViewRay>();
+    build(ray.get());
+    std::lock_guard<std::mutex> lock(ray_mutex_);
+    if (rays_.size() >= kMaxCachedRays) return ray;
+    return rays_.emplace(key, std::move(ray)).first->second;
+  }
+  static constexpr size_t kMaxCachedRays = 64;  // ~0.15 MB each at 48 wavelengths and 4 components
+  mutable std::mutex ray_mutex_;
+  mutable std::map<std::pair<double, double>, std::shared_ptr<const ViewRay>> rays_;
 };
 
 // ---------------------------------------------------------------------------- medium
@@ -1642,27 +1682,18 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
   const size_t nd = nu_ * static_cast<size_t>(s_.nphi);
   // Log-linear interpolation of the MS table in the sun angle (exact for exponential twilight decay).
   const Lerp ls = Locate(sun_theta_rad_, ts);
-  std::vector<float> tsun(nw_), st(nw_), acc(nw_), ms0(nw_), ms1(nw_), pc(nc_ * nw_), jv(nw_), jv1(nw_);
+  std::vector<float> tsun(nw_), st(nw_), acc(nw_), ms0(nw_), ms1(nw_), pc(nc_ * nw_), jv(nw_), jv1(nw_), hwt(nw_);
   std::vector<double> seg_ms(nw_);
 
   // What along a view ray does not depend on the sun or the azimuth - the steps, the medium at
   // each point and its transmittance from the observer - is computed once per view zenith
   // cosine and reused while the directions share it (a LUT row, an ambient ring: 32-128
-  // directions per call; it was two thirds of a clear-sky LUT's render).
-  struct Point {
-    double t = 0.0, rr = 0.0, mu2 = 0.0;
-    Lerp sun_r;  // the sun transmittance table's radius position
-  };
-  struct Ray {
-    double mu = 2.0;  // none yet
-    double length = 0.0;
-    bool ground = false;
-    std::vector<Point> pts;
-    std::vector<float> e;      // [(p * nc + c) * nw + w]: half-step x T(0, t_p) x sigma_s,c (single scattering weight)
-    std::vector<float> seg;    // [p * nw + w]: half-step x T*(0, t_p) x sigma_s* (segments' multiple scattering)
-    std::vector<float> t_end;  // [w] transmittance to the ray's end (the ground)
-  } ray;
-  auto build_ray = [&](double mu) {
+  // directions per call; it was two thirds of a clear-sky LUT's render), and, for whole view
+  // rays, kept across calls (CachedViewRay: a LUT's 64 slices share their rows' rays).
+  ViewRay local;
+  std::shared_ptr<const ViewRay> cached;
+  const ViewRay* cur = nullptr;
+  auto build_ray = [&](double mu, ViewRay& ray) {
     ray.mu = mu;
     ray.pts.clear();
     ray.e.clear();
@@ -1722,10 +1753,12 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
         const float hw = static_cast<float>(segment == nullptr || segment->single_scattering ? 0.5 * h : 0.0);
         const size_t e0 = ray.e.size();
         ray.e.resize(e0 + nc_ * nw_);
+        // Single precision exp (the radiance is accumulated in float anyway), once per point for
+        // all components (it was a third of a LUT row's ray build when taken per component).
+        for (size_t w = 0; w < nw_; ++w) hwt[w] = hw * ExpF(-static_cast<float>(tau[w]));
         for (size_t c = 0; c < nc_; ++c) {
           SigmaS(c, cell, false, st.data());
-          // Single precision exp: the radiance is accumulated in float anyway.
-          for (size_t w = 0; w < nw_; ++w) ray.e[e0 + c * nw_ + w] = hw * ExpF(-static_cast<float>(tau[w])) * st[w];
+          for (size_t w = 0; w < nw_; ++w) ray.e[e0 + c * nw_ + w] = hwt[w] * st[w];
         }
         if (segment != nullptr) {
           const size_t s0 = ray.seg.size();
@@ -1765,7 +1798,16 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
     const double sn = std::sqrt(std::max(0.0, 1.0 - mu * mu));
     const double cphi = sn > 1e-12 ? dirs[d][0] / sn : 1.0;
     const double nu = dirs[d][0] * std::sin(ts) + mu * std::cos(ts);  // the sun is (sin ts, 0, cos ts)
-    if (mu != ray.mu) build_ray(mu);
+    if (cur == nullptr || mu != cur->mu) {
+      if (segment == nullptr) {
+        cached = CachedViewRay(observer_altitude_m, mu, [&](ViewRay* ray) { build_ray(mu, *ray); });
+        cur = cached.get();
+      } else {
+        build_ray(mu, local);
+        cur = &local;
+      }
+    }
+    const ViewRay& ray = *cur;
     // --- single scattering along the view ray (unscaled medium, full phase)
     for (size_t c = 0; c < nc_; ++c) {
       // The phase times the sun's irradiance (per direction, not per point).
@@ -1774,7 +1816,7 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
     std::fill(acc.begin(), acc.end(), 0.0f);
     std::fill(seg_ms.begin(), seg_ms.end(), 0.0);
     for (size_t p = 0; p < ray.pts.size(); ++p) {
-      const Point& pt = ray.pts[p];
+      const ViewPoint& pt = ray.pts[p];
       const double mus = (r * std::cos(ts) + pt.t * nu) / pt.rr;
       if (segment == nullptr || segment->single_scattering) {
         SunTransmittanceAt(pt.sun_r, mus, false, tsun.data());
