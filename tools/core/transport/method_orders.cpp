@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -23,6 +24,30 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kDeg = kPi / 180.0;
+
+// out[w] = sum_{k in [k0, k1)} wv[k] v[k][w], summed in k order: the transport's gather of J at a
+// table ray's step. Eight wavelengths at a time in a GCC vector (one register with AVX2, two with
+// SSE2), the sum kept in it across the corners; each lane rounds exactly as the scalar loop
+// (contraction is off: CMakeLists.txt), so the bytes are those of the plain form. The plain form,
+// one corner at a time into out[], stored and reloaded the sum for each corner.
+void Gather16(const float* const* v, const float* wv, int k0, int k1, size_t nw, float* out) {
+  using V8 = float __attribute__((vector_size(32)));
+  size_t w = 0;
+  for (; w + 8 <= nw; w += 8) {
+    V8 sum = {};
+    for (int k = k0; k < k1; ++k) {
+      V8 x;
+      std::memcpy(&x, v[k] + w, sizeof x);
+      sum += wv[k] * x;
+    }
+    std::memcpy(out + w, &sum, sizeof sum);
+  }
+  for (; w < nw; ++w) {
+    float sum = 0.0f;
+    for (int k = k0; k < k1; ++k) sum += wv[k] * v[k][w];
+    out[w] = sum;
+  }
+}
 
 // ---------------------------------------------------------------------------- settings
 
@@ -1558,23 +1583,30 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
             const SunAzimuth p = sa != nullptr ? sa[m] : step_sun_azimuth(f, m, r, ts, nu);
             if (p.si == kNoSun) continue;
             const size_t so = (static_cast<size_t>(p.si) * nu_) * nphi + p.q0;
-            const size_t sofs[4] = {so, so + 1, so + nu_ * nphi, so + nu_ * nphi + 1};
             const float ws[4] = {(1.0f - p.ts) * (1.0f - p.tq), (1.0f - p.ts) * p.tq, p.ts * (1.0f - p.tq), p.ts * p.tq};
+            // A corner of weight 0 reads the first one (its own cell may lie past the table's
+            // end: the last azimuth or sun node with t = 0).
+            const size_t sofs[4] = {so, ws[1] != 0.0f ? so + 1 : so, ws[2] != 0.0f ? so + nu_ * nphi : so,
+                                    ws[3] != 0.0f ? so + nu_ * nphi + 1 : so};
             const Family::Corners& c = f.rc[m];
-            float* jvp = jv.data();
-            std::fill(jvp, jvp + nw_, 0.0f);
-            const bool loglin = p.si >= loglin_first && p.ts > 0.0f;
-            if (loglin) std::fill(jv2.begin(), jv2.end(), 0.0f);
+            const float* v[16];
+            float wv[16];
             for (int a = 0; a < 4; ++a) {
-              if (c.w[a] == 0.0f) continue;
-              // Twilight: the upper radius corner accumulates apart, for its own factor C.
-              float* dst = loglin && a >= 2 ? jv2.data() : jvp;
               for (int b = 0; b < 4; ++b) {
-                const float wab = c.w[a] * ws[b];
-                if (wab == 0.0f) continue;
-                const float* v = &Jin[(c.off[a] + sofs[b]) * nw_];
-                for (size_t w = 0; w < nw_; ++w) dst[w] += wab * v[w];
+                v[4 * a + b] = &Jin[(c.off[a] + sofs[b]) * nw_];
+                wv[4 * a + b] = c.w[a] * ws[b];
               }
+            }
+            float* jvp = jv.data();
+            // The 16 products summed in one pass per wavelength, in corner order (a term of
+            // weight 0 adds +-0: the same sums as skipping it); twilight: the upper radius
+            // corners accumulate apart, for their own factor C.
+            const bool loglin = p.si >= loglin_first && p.ts > 0.0f;
+            if (!loglin) {
+              Gather16(v, wv, 0, 16, nw_, jvp);
+            } else {
+              Gather16(v, wv, 0, 8, nw_, jvp);
+              Gather16(v, wv, 8, 16, nw_, jv2.data());
             }
             if (loglin) {
               const float fb = p.ts * kLogBins;
