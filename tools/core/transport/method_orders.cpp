@@ -1730,6 +1730,10 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
     ray.pts.clear();
     ray.e.clear();
     ray.seg.clear();
+    const size_t npts = 2 * static_cast<size_t>(s_.nss);
+    ray.pts.reserve(npts);
+    ray.e.reserve(npts * nc_ * nw_);
+    if (segment != nullptr) ray.seg.reserve(npts * nw_);
     const double disc_g = r * r * (mu * mu - 1.0) + R * R;
     // Segments never include the ground surface (transport/view_segment.h).
     ray.ground = segment == nullptr && mu < 0.0 && disc_g >= 0.0;
