@@ -8,7 +8,7 @@
 //   luts:
 //     method: orders               # sky-render method of the LUT renders (docs/sky-methods.md)
 //     quality: medium              # its quality preset
-//     spectral_stride: 4           # the method on every 4th wavelength, transfer interpolated (1 = all)
+//     spectral_stride: 2           # the method on every 2nd wavelength, transfer interpolated (1 = all)
 //     time_mapping: gt7-quadratic  # or gt7 (the talk's; docs/lut-pack.md), optionally ":<upper>+<lower>"
 //     sky_exposure_stops: auto     # or N: sky texels store cd/m^2 x 2^N (auto: per texture, no clamping)
 //     budget_mib: 3.5              # lut-pack fails when the sky LUTs exceed it
