@@ -1730,7 +1730,7 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
   // each point and its transmittance from the observer - is computed once per view zenith
   // cosine and reused while the directions share it (a LUT row, an ambient ring: 32-128
   // directions per call; it was two thirds of a clear-sky LUT's render), and, for whole view
-  // rays, kept across calls (CachedViewRay: a LUT's 64 slices share their rows' rays).
+  // rays, kept across calls (CachedViewRay: the LUT's ambient rings recur in every sun slice).
   ViewRay local;
   std::shared_ptr<const ViewRay> cached;
   const ViewRay* cur = nullptr;
