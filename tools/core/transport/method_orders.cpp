@@ -83,10 +83,17 @@ struct OrdersSettings {
   // overweights a step whose point is denser than its mean (a thick cloud's orders then never
   // converged: cloudy5, docs/sky-methods.md "Step weights").
   bool step_albedo = true;
-  // The scaled sun table with the unscaled one's nodes and logarithmic blend: the low sun's
-  // sky comes within the target, but thick clouds lose 15-20 % (the old table's error holds up
-  // their sources; docs/sky-methods.md "Sun transmittance"). Off until both are fixed together.
-  bool scaled_sun_exact = false;
+  // The scaled sun table (the sources of the multiple-scattering tables) with the unscaled one's
+  // nodes and logarithmic blend; false: nodes quadratic in altitude and a linear blend, which
+  // overestimates the sun inside a thick layer and at a low sun's horizon (docs/sky-methods.md
+  // "Sun transmittance"). Together with tau_centroid since 2026-11-23 (fifth stop): each alone
+  // is worse, the old table's error having held up the thick layers' sources.
+  bool scaled_sun_exact = true;
+  // A table ray's step takes its sources at the point of its centroid in optical depth, tau0 +
+  // g dtau, whatever the medium's shape within the step; false: at t0 + g dt, the centroid of a
+  // uniform medium, which for a step straddling a cloud's edge fell in the clear air and lost the
+  // step's sources (docs/sky-methods.md "Step weights").
+  bool tau_centroid = true;
   // Largest share of the total the geometric tail may have when taken early (see the stopping
   // rule in SolveMultipleScattering).
   double tail_share_max = 0.1;
@@ -140,6 +147,7 @@ OrdersSettings SettingsFor(const SkyMethodOptions& o) {
   if (tsp > 0) s.tail_share_max = tsp / 100.0;
   get_flag("step_albedo", &s.step_albedo);
   get_flag("scaled_sun_exact", &s.scaled_sun_exact);
+  get_flag("tau_centroid", &s.tau_centroid);
   get_flag("kernel_modal", &s.kernel_modal);
 
   int loglin = 0;
@@ -547,8 +555,9 @@ void OrdersMethod::BuildSunTables() {
   // at the output): uniform in s(h) = (tau(0,h)/tau(0,H) + (h/H)^0.5) / 2, tau the vertical
   // optical depth at the grid's shortest wavelength - half the nodes quadratic in altitude (dense
   // near the ground), half where the extinction is. The scaled table (the sources of the
-  // multiple-scattering tables) keeps the nodes quadratic in altitude: see "Sun transmittance"
-  // in docs/sky-methods.md for why it is not yet changed with it.
+  // multiple-scattering tables) has the same nodes and blend (scaled_sun_exact; before the fifth
+  // stop of 2026-11-23 quadratic in altitude and linear: "Sun transmittance" in
+  // docs/sky-methods.md).
   const double tau_top = std::max(m_.VerticalOpticalDepth(0.0, H, 0), 1e-12);
   auto s_of = [&](double h) { return 0.5 * (m_.VerticalOpticalDepth(0.0, h, 0) / tau_top + std::sqrt(h / H)); };
   for (double h : AltitudesUniformIn(s_of, nr, H)) sun_.r.push_back(R + h);
@@ -909,7 +918,19 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
         const double h = t1 - t0;
         const double a = tau_at(t1, wref) - tau_at(t0, wref);
         const double g = a < 1e-3 ? 0.5 - a / 12.0 : 1.0 / a - 1.0 / std::expm1(a);
-        const double tm = t0 + h * g;
+        double tm = t0 + h * g;
+        if (s_.tau_centroid && a >= 1e-3) {
+          // The centroid in optical depth, tau0 + g a, whatever the medium's shape within the
+          // step (the weight is e^-tau dtau in optical depth): the point where that depth is
+          // reached, inside the medium, never in the clear air of a step that straddles a
+          // cloud's edge (that lost the step's sources: under a tau-8 layer the sky came out
+          // 10-20 % dark once the scaled sun table no longer overestimated the sun there).
+          const double pf = std::clamp(t0 / f.d * nf, 0.0, static_cast<double>(nf));
+          const size_t pi = std::min(static_cast<size_t>(pf), static_cast<size_t>(nf) - 1);
+          const double tau0 = cum[pi] + (cum[pi + 1] - cum[pi]) * (pf - static_cast<double>(pi));
+          const Lerp l = Locate(cum, tau0 + g * a);
+          tm = std::clamp((static_cast<double>(l.i) + l.t) * f.d / nf, t0, t1);
+        }
         f.t.push_back(tm);
         const double rr = std::sqrt(r * r + 2.0 * r * mu * tm + tm * tm);
         f.r.push_back(rr);
