@@ -32,7 +32,9 @@ TEST(FogModel, DepthFactorEndpoints) {
     EXPECT_NEAR(DepthFactor(1.0 - 1e-12, k), 1.0, 1e-9 * std::max(1.0, std::min(k, 1e3))) << k;
     // x -> 0: F ~ x k / (1 - e^-k) -> 0 (the slope at 0, finite for finite k).
     const double slope = k > 0 ? k / -std::expm1(-k) : 1.0;
-    if (k < 1e5) EXPECT_NEAR(DepthFactor(1e-12, k) / 1e-12, slope, 1e-6 * slope) << k;
+    if (k < 1e5) {
+      EXPECT_NEAR(DepthFactor(1e-12, k) / 1e-12, slope, 1e-6 * slope) << k;
+    }
     // Monotone and in [0, 1].
     double prev = 0.0;
     for (int i = 1; i <= 100; ++i) {

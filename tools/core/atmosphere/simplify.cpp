@@ -81,16 +81,19 @@ std::vector<double> FitTent(const std::vector<double>& z, const std::vector<doub
 VerticalProfiles AnalyticProfiles(const VerticalProfiles& p, std::vector<ProfileFit>* fits) {
   VerticalProfiles out = p;
   std::vector<ProfileFit> f;
-  ProfileFit air{"air"};
+  ProfileFit air;
+  air.constituent = "air";
   out.air_number_density_m3 = FitExponential(p.altitude_m, p.air_number_density_m3, &air);
   f.push_back(air);
   if (p.has_ozone) {
-    ProfileFit oz{"ozone"};
+    ProfileFit oz;
+    oz.constituent = "ozone";
     out.ozone_number_density_m3 = FitTent(p.altitude_m, p.ozone_number_density_m3, &oz);
     f.push_back(oz);
   }
   for (size_t k = 0; k < p.aerosols.size(); ++k) {
-    ProfileFit a{"aerosol." + p.aerosols[k].name};
+    ProfileFit a;
+    a.constituent = "aerosol." + p.aerosols[k].name;
     out.aerosols[k].shape_per_m = FitExponential(p.altitude_m, p.aerosols[k].shape_per_m, &a);
     f.push_back(a);
   }
