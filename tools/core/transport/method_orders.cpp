@@ -902,11 +902,15 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
       };
       f.wt.resize(nt * nw_);
       f.ssc.assign(nt * nw_, 0.0f);
-      auto tau_at = [&](double tv, size_t w) {
+      // Position of t on the fine sub-grid: the piece and the fraction into it.
+      auto fine_at = [&](double tv) {
         const double pf = std::clamp(tv / f.d * nf, 0.0, static_cast<double>(nf));
         const size_t pi = std::min(static_cast<size_t>(pf), static_cast<size_t>(nf) - 1);
-        const double pt = pf - static_cast<double>(pi);
-        return cum_w[pi][w] + (cum_w[pi + 1][w] - cum_w[pi][w]) * pt;
+        return Lerp{pi, pf - static_cast<double>(pi)};
+      };
+      auto tau_at = [&](double tv, size_t w) {
+        const Lerp l = fine_at(tv);
+        return cum_w[l.i][w] + (cum_w[l.i + 1][w] - cum_w[l.i][w]) * l.t;
       };
       for (size_t m = 0; m < nt; ++m) {
         const double t0 = t_of_s(static_cast<double>(m) / nt), t1 = t_of_s(static_cast<double>(m + 1) / nt);
@@ -925,9 +929,8 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
           // reached, inside the medium, never in the clear air of a step that straddles a
           // cloud's edge (that lost the step's sources: under a tau-8 layer the sky came out
           // 10-20 % dark once the scaled sun table no longer overestimated the sun there).
-          const double pf = std::clamp(t0 / f.d * nf, 0.0, static_cast<double>(nf));
-          const size_t pi = std::min(static_cast<size_t>(pf), static_cast<size_t>(nf) - 1);
-          const double tau0 = cum[pi] + (cum[pi + 1] - cum[pi]) * (pf - static_cast<double>(pi));
+          const Lerp l0 = fine_at(t0);
+          const double tau0 = cum[l0.i] + (cum[l0.i + 1] - cum[l0.i]) * l0.t;
           const Lerp l = Locate(cum, tau0 + g * a);
           tm = std::clamp((static_cast<double>(l.i) + l.t) * f.d / nf, t0, t1);
         }
