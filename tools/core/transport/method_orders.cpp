@@ -939,8 +939,9 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
         f.r.push_back(rr);
         f.mu.push_back((r * mu + tm) / rr);
         f.rv.push_back(RadialViewAt(rr, f.mu.back()));
+        const AtmosphereModel::Cell cell = m_.Locate(rr - R);  // one lookup for the step's media
         for (size_t c = 0; c < nc_; ++c) {
-          SigmaS(c, rr - R, true, sc.data());
+          SigmaS(c, cell, true, sc.data());
           for (size_t w = 0; w < nw_; ++w) f.ssc[m * nw_ + w] += sc[w];
         }
         // The step's weight of J: int T* sigma_s* dt taken as sigma_s*/sigma_t* at the point times
@@ -948,7 +949,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
         // point times the exact int T* dt (before 2026-11-23): where the point's extinction
         // exceeds the step's mean (a dense cloud's steps) that weighted J by more than the light
         // the step can scatter, and cloudy5's orders grew without end (docs/sky-methods.md).
-        SigmaT(rr - R, true, st.data());
+        SigmaT(cell, true, st.data());
         for (size_t w = 0; w < nw_; ++w) {
           const double tau0 = tau_at(t0, w), dtau = std::max(0.0, tau_at(t1, w) - tau0);
           if (s_.step_albedo && dtau > 1e-6 && st[w] > 0.0f) {
