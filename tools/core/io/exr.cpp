@@ -104,7 +104,22 @@ int ExrTable::ChannelIndex(const std::string& name) const {
 }
 
 void Provenance::AddInput(const std::filesystem::path& path) {
-  inputs.emplace_back(path.lexically_normal().string(), HashFile(path));
+  // An absolute path (a table or config the tool found in the repository by itself, or one given
+  // absolute) is recorded relative to the working directory, like the inputs given relative: the
+  // same inputs baked in another folder then give the same bytes (docs/design.md, "File
+  // conventions"). A path on another root (no relative form) stays as it is.
+  std::filesystem::path recorded = path;
+  if (path.is_absolute()) {
+    std::error_code ec;
+    const std::filesystem::path cwd = std::filesystem::current_path(ec);
+    if (!ec) {
+      // The working directory comes back with its symbolic links resolved: resolve the path's too.
+      const std::filesystem::path canonical = std::filesystem::weakly_canonical(path, ec);
+      const std::filesystem::path rel = ec ? std::filesystem::path() : canonical.lexically_proximate(cwd);
+      if (!rel.empty()) recorded = rel;
+    }
+  }
+  inputs.emplace_back(recorded.lexically_normal().generic_string(), HashFile(path));
 }
 
 void SetProvenance(ExrImage& image, const Provenance& p) {
