@@ -148,18 +148,23 @@ TEST(MethodOrders, AgainstThePathTracerFromDaylightToTwilight) {
 
 // `high` against the path tracer at the daylight target (RMS <= 0.5 %, max <= 2 % outside
 // the aureole) on the hazed sky with the sun 30 and 70 deg from the zenith: ten directions
-// (SkyDirs), 0.5 % references, the 21-wavelength test grid. Measured here: noise-corrected RMS
-// 0.27 / 0.43 %, max 0.93 / 1.77 % (with 0.4 % references 0.36 / 0.51 %, 0.89 / 1.52 %); on the 48-wavelength grid with 35
-// directions 0.37 / 0.40 % RMS, 1.31 / 1.18 % max (docs/sky-methods.md "Measured accuracy"). The
-// RMS bound is the target plus this grid's 0.1 %; with the sun at 85 deg high is 1.9 % RMS (the
-// low-sun horizon, not asserted here).
+// (SkyDirs), 0.3 % references, a 10 nm grid (41 wavelengths). Measured here (2026-11-24, cones per
+// component and 192 sun-table radius nodes): noise-corrected RMS 0.49 / 0.41 %, max 1.03 / 1.01 %.
+// On the 20 nm test grid the same code gives 0.67 / 0.42 % (+1.0 and +1.4 % at 40 deg across and
+// 60 deg away from the sun at sun 30 deg, where the 10 nm grid and the pipeline's 48-wavelength
+// grid give +0.4 to +1.0 %), so this test uses the finer grid. On the pipeline's grid with 35
+// directions: 0.21 / 0.36 % RMS, 1.11 / 1.10 % max (docs/sky-methods.md "Measured accuracy"). The
+// RMS bound is the target plus 0.1 %; with the sun at 85 deg high is 0.53 % RMS, max 2.1 % (not
+// asserted here).
 TEST(MethodOrders, HighAtTheDaylightTargetOnTheHazedSky) {
-  const TestScene sc = LoadTestScene("hazed");
+  SceneOptions so;
+  so.step_nm = 10.0;
+  const TestScene sc = LoadTestScene("hazed", so);
   SkyMethodOptions o;
   o.quality = "high";
   const std::unique_ptr<SkyMethod> orders = MakeSkyMethod("orders", sc.model, o, {});
   for (double sza : {30.0, 70.0}) {
-    const std::vector<ColorEstimate> ref = PathY(sc, sza, SkyDirs(), 0.005);
+    const std::vector<ColorEstimate> ref = PathY(sc, sza, SkyDirs(), 0.003);
     const std::vector<double> y = MethodY(sc, *orders, sza, SkyDirs());
     double ss = 0.0, noise = 0.0, worst = 0.0;
     for (size_t d = 0; d < y.size(); ++d) {

@@ -58,10 +58,25 @@ struct OrdersSettings {
   int nt = 40;               // steps along a table ray
   int nss = 96;              // steps along an output view ray (single scattering)
   int fine = 256;            // pieces for optical depths along a ray
+  // Truncation cone per scattering component, between truncation_min_deg and truncation_deg: the
+  // smallest (in 0.5 deg steps) outside which the phase function falls by at most
+  // kPeakRatioPerInterval over one azimuth interval of the tables at every wavelength, so that what
+  // the kernel must integrate is no sharper than its grid resolves ("Truncation cone" in
+  // docs/sky-methods.md). A continental aerosol gets the smallest cone, a cloud droplet's
+  // diffraction peak a wider one.
   double truncation_deg = 5.0;
+  double truncation_min_deg = 0.0;  // 0: the same as truncation_deg (one cone for all)
   double tau_cap = 12.0;     // optical depth beyond which a table ray's steps follow distance only
   double rho_cap = 0.98;     // largest ratio of successive orders the geometric tail extrapolates
-  int sun_nr = 48;           // radius nodes of the sun transmittance table
+  // The sun transmittance tables: radius nodes, and the sun-zenith node spacing from 80 to 110 deg.
+  // log T is blended linearly between radius nodes and is convex there, so too few nodes make a
+  // low sun's transmittance low: the hazed sky's single scattering at sun 85 deg came out 0.36 %
+  // dark with 48 nodes (0.09 % with 96, 0.03 % with 200) against the path tracer's first order
+  // (0.2 % references), while 0.05 and 0.1 deg zenith steps differ by <= 0.03 % even in twilight
+  // ("Sun transmittance" in docs/sky-methods.md). Until 2026-11-24: 48 nodes and 0.05 deg, the
+  // same table size and cost as 96 and 0.1 deg.
+  int sun_nr = 96;
+  double sun_low_step_deg = 0.1;
   double loglin_from_deg = 90.0;  // sun-node intervals from here on: J blended log-linearly in the sun angle (> 180: never)
   double view_power = 2.0;   // view nodes: power of the node spacing in angle from the horizon
   bool normalise = true;     // kernel rows scaled to conserve energy
@@ -106,13 +121,15 @@ OrdersSettings SettingsFor(const SkyMethodOptions& o) {
   OrdersSettings s;
   if (o.quality == "low") {
     s.nr = 10, s.nup = 10, s.ndn = 6, s.nphi = 6, s.nt = 24, s.nss = 48, s.fine = 128, s.tolerance = 3e-3;
+    s.sun_nr = 48;
   } else if (o.quality == "medium") {
     // defaults above
   } else if (o.quality == "high") {
     // Measured on the hazed sky (docs/sky-methods.md, "Scattering kernel"): the azimuth count and
     // a kernel that resolves the aerosol lobe matter; more radius nodes or ray steps do not.
     s.nup = 24, s.ndn = 12, s.nphi = 24, s.nss = 160, s.fine = 512, s.tolerance = 3e-4;
-    s.kernel_sub = 4, s.truncation_deg = 3.0;
+    s.kernel_sub = 4, s.truncation_deg = 3.0, s.truncation_min_deg = 1.0;
+    s.sun_nr = 192;
   } else {
     throw UsageError("--quality: expected low, medium or high, got '" + o.quality + "'");
   }
@@ -134,11 +151,18 @@ OrdersSettings SettingsFor(const SkyMethodOptions& o) {
   int trunc = 0;
   get("truncation_deg", &trunc);
   if (trunc > 0) s.truncation_deg = trunc;
+  int trunc_min = 0;
+  get("truncation_min_deg", &trunc_min);
+  if (trunc_min > 0) s.truncation_min_deg = trunc_min;
+  if (s.truncation_min_deg <= 0.0 || s.truncation_min_deg > s.truncation_deg) s.truncation_min_deg = s.truncation_deg;
   get_flag("normalise", &s.normalise);
   int cap = 0;
   get("tau_cap", &cap);
   if (cap > 0) s.tau_cap = cap;
   get("sun_radius_nodes", &s.sun_nr);
+  int sun_low_step_x100 = 0;
+  get("sun_low_step_x100", &sun_low_step_x100);
+  if (sun_low_step_x100 > 0) s.sun_low_step_deg = sun_low_step_x100 / 100.0;
   int ksub = -1;
   get("kernel_sub", &ksub);
   if (ksub >= 0) s.kernel_sub = ksub;
@@ -243,9 +267,20 @@ class OrdersMethod : public SkyMethod {
         "method: orders\nradius_nodes: {}\nview_nodes: {} up + {} down per altitude\nazimuth_nodes: {}\n"
         "sun_nodes: {}\nray_steps: {}\nview_steps: {}\ntruncation_deg: {}\nkernel: {}\norders_computed: {}\n"
         "tail_extrapolated: {}\nlast_order_fraction: {:.3g}\ntolerance: {}\n",
-        radius_.size(), s_.nup, s_.ndn, s_.nphi, s_.sun_deg.size(), s_.nt, s_.nss, s_.truncation_deg,
+        radius_.size(), s_.nup, s_.ndn, s_.nphi, s_.sun_deg.size(), s_.nt, s_.nss, ConesText(),
         s_.kernel_sub > 0 ? fmt::format("basis-integrated, {} sub-intervals", s_.kernel_sub) : std::string("phase at the nodes"), orders_done_,
         tail_ ? "true" : "false", last_fraction_, s_.tolerance);
+  }
+
+  // "1 (rayleigh), 3 (aerosol.cloud)": each scattering component's truncation cone, deg.
+  std::string ConesText() const {
+    std::string text;
+    size_t c = 0;
+    for (const MediumComponent& mc : m_.components) {
+      if (!mc.phase) continue;
+      text += fmt::format("{}{:g} ({})", text.empty() ? "" : ", ", cone_deg_[c++], mc.name);
+    }
+    return text;
   }
 
   void Radiance(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,
@@ -359,6 +394,7 @@ class OrdersMethod : public SkyMethod {
   std::vector<float> sigma_t_, sigma_t_star_, sigma_s_, sigma_s_star_;
   std::vector<std::shared_ptr<const PhaseModel>> phase_;  // per component
   std::vector<double> f_;                                   // truncated fraction [c*nw+w]
+  std::vector<double> cone_deg_;                            // truncation cone per component, deg
   std::vector<float> phase_star_;                           // [(c*ng+g)*nw+w] on cos grid
   static constexpr int kPhaseGrid = 2048;
   std::vector<double> albedo_, sun_e_;
@@ -440,17 +476,41 @@ void OrdersMethod::PrepareMedium() {
   albedo_ = m_.ground_albedo;
   sun_e_ = m_.sun.irradiance;
 
+  // Each component's truncation cone (OrdersSettings::truncation_min_deg): the smallest angle in
+  // 0.5 deg steps from the minimum up to truncation_deg at which, for every wavelength, the phase
+  // function one azimuth interval further out is no more than kPeakRatioPerInterval times lower.
+  // Measured at 550 nm (docs/sky-methods.md "Truncation cone"): the continental aerosol falls 4.3x
+  // from 1 deg to 8.5 deg (1 deg cone at high's 24 azimuths), a 10 um water droplet 210x from 1 deg
+  // and 6.9x from 3 deg (3 deg cone).
+  constexpr double kPeakRatioPerInterval = 10.0;
+  const double interval_deg = 180.0 / s_.nphi;  // azimuth nodes at cell centres, pi / nphi apart
+  cone_deg_.assign(nc_, s_.truncation_deg);
+  for (size_t c = 0; c < nc_; ++c) {
+    for (double th = s_.truncation_min_deg; th < s_.truncation_deg - 1e-9; th += 0.5) {
+      bool smooth = true;
+      for (size_t w = 0; w < nw_ && smooth; ++w) {
+        const double p0 = phase_[c]->Eval(w, std::cos(th * kDeg));
+        const double p1 = phase_[c]->Eval(w, std::cos(std::min(180.0, th + interval_deg) * kDeg));
+        smooth = p0 <= kPeakRatioPerInterval * p1;
+      }
+      if (smooth) {
+        cone_deg_[c] = th;
+        break;
+      }
+    }
+  }
+
   // Truncated fractions and truncated phase functions on a uniform grid in cos(theta).
-  const double cos_c = std::cos(s_.truncation_deg * kDeg);
   f_.assign(nc_ * nw_, 0.0);
   phase_star_.assign(nc_ * kPhaseGrid * nw_, 0.0f);
   for (size_t c = 0; c < nc_; ++c) {
+    const double cos_c = std::cos(cone_deg_[c] * kDeg);
     for (size_t w = 0; w < nw_; ++w) {
       // f = 2 pi int_{cos_c}^{1} (P(mu) - P(cos_c)) dmu, integrated in theta on a log grid
       // (the forward peak of large particles is ~1/x rad wide).
       const double p_c = phase_[c]->Eval(w, cos_c);
       const int n = 4000;
-      const double th_min = 1e-5, th_max = s_.truncation_deg * kDeg;
+      const double th_min = 1e-5, th_max = cone_deg_[c] * kDeg;
       double f = 0.0, prev_th = 0.0, prev_v = 2 * kPi * std::max(0.0, phase_[c]->Eval(w, 1.0) - p_c) * 0.0;
       for (int i = 0; i <= n; ++i) {
         const double th = th_min * std::pow(th_max / th_min, static_cast<double>(i) / n);
@@ -571,9 +631,11 @@ void OrdersMethod::BuildSunTables() {
   }
   sun_.log_blend = true;
   sun_star_.log_blend = s_.scaled_sun_exact;
-  // Sun zenith nodes (deg): 1 deg to 80, 0.05 deg to 110 (the horizon and the Earth's shadow), 1 deg to 125.
+  // Sun zenith nodes (deg): 1 deg to 80, sun_low_step_deg (0.1) to 110 (the horizon and the Earth's
+  // shadow), 1 deg to 125.
   for (double a = 0; a < 80; a += 1.0) sun_theta_deg_.push_back(a);
-  for (double a = 80; a < 110; a += 0.05) sun_theta_deg_.push_back(a);
+  const int n_low = static_cast<int>(std::lround(30.0 / s_.sun_low_step_deg));
+  for (int k = 0; k < n_low; ++k) sun_theta_deg_.push_back(80.0 + k * s_.sun_low_step_deg);
   for (double a = 110; a <= 125 + 1e-9; a += 1.0) sun_theta_deg_.push_back(a);
   const size_t nt = sun_theta_deg_.size();
   sun_theta_loc_ = IntervalLocator(sun_theta_deg_);
