@@ -12,6 +12,7 @@
 #include "io/exr.h"
 #include "io/fileio.h"
 #include "io/png.h"
+#include "io/repo_paths.h"
 
 namespace fs = std::filesystem;
 using namespace skybake;
@@ -82,29 +83,28 @@ TEST(Exr, TableRoundTripWithProvenance) {
   EXPECT_EQ(t2.values, t.values);
 }
 
-// Provenance must not depend on the folder the bake runs in: an absolute input path (the CMF table
-// or OCIO config a tool finds in the repository by itself) is recorded relative to the working
-// directory, as the inputs given relative are; the same file from two folders gives the same entry.
-TEST(Exr, ProvenanceRecordsAbsoluteInputsRelativeToTheWorkingDirectory) {
-  const fs::path root = fs::absolute(TempDir() / "prov");
-  std::string entries[2];
-  for (int k = 0; k < 2; ++k) {
-    const fs::path checkout = root / (k == 0 ? "checkout_a" : "deeper/checkout_b");
-    fs::create_directories(checkout / "data");
-    fs::create_directories(checkout / "outputs");
-    ASSERT_TRUE(WriteFileIfChanged(checkout / "data" / "table.csv", "# source: test\nx,y\n1,2\n"));
-    const fs::path before = fs::current_path();
-    fs::current_path(checkout / "outputs");
-    Provenance p;
-    p.AddInput(checkout / "data" / "table.csv");   // absolute, as FindRepoFile returns it
-    p.AddInput("../data/table.csv");                // relative, as given on a command line
-    fs::current_path(before);
-    ASSERT_EQ(p.inputs.size(), 2u);
-    EXPECT_EQ(p.inputs[0], p.inputs[1]);
-    entries[k] = p.inputs[0].first + " " + p.inputs[0].second;
-  }
-  EXPECT_EQ(entries[0], entries[1]);
-  EXPECT_EQ(entries[0].substr(0, 18), "../data/table.csv ");
+// Provenance must not depend on the checkout the bake runs in: a repository file named by an
+// absolute path (the CMF table or OCIO config a tool finds by itself) is recorded relative to the
+// working directory, as the same file given relative is; a file outside the repository keeps the
+// path it was given.
+TEST(Exr, ProvenanceRecordsRepositoryFilesRelativeToTheWorkingDirectory) {
+  const fs::path cmf = FindRepoFile("atmospheres/data/cie2006_2deg_xyz_cmf_1nm.csv");
+  ASSERT_TRUE(cmf.is_absolute());
+  const std::optional<fs::path> root = RepoRoot();
+  ASSERT_TRUE(root.has_value());
+  const fs::path outside = fs::absolute(TempDir() / "outside.csv");
+  ASSERT_TRUE(WriteFileIfChanged(outside, "# source: test\nx,y\n1,2\n"));
+  const fs::path before = fs::current_path();
+  fs::current_path(*root / "tests");  // a folder inside the checkout, as outputs/ is for a bake
+  Provenance p;
+  p.AddInput(cmf);
+  p.AddInput("../atmospheres/data/cie2006_2deg_xyz_cmf_1nm.csv");
+  p.AddInput(outside);
+  fs::current_path(before);
+  ASSERT_EQ(p.inputs.size(), 3u);
+  EXPECT_EQ(p.inputs[0].first, "../atmospheres/data/cie2006_2deg_xyz_cmf_1nm.csv");
+  EXPECT_EQ(p.inputs[0], p.inputs[1]);
+  EXPECT_EQ(p.inputs[2].first, outside.lexically_normal().generic_string());
 }
 
 TEST(Exr, TruncatedAndGarbageFilesAreInputErrors) {

@@ -25,6 +25,7 @@
 
 #include "io/error.h"
 #include "io/fileio.h"
+#include "io/repo_paths.h"
 #include "io/yaml.h"
 #include "skybake/version.h"
 
@@ -104,19 +105,22 @@ int ExrTable::ChannelIndex(const std::string& name) const {
 }
 
 void Provenance::AddInput(const std::filesystem::path& path) {
-  // An absolute path (a table or config the tool found in the repository by itself, or one given
-  // absolute) is recorded relative to the working directory, like the inputs given relative: the
-  // same inputs baked in another folder then give the same bytes (docs/design.md, "File
-  // conventions"). A path on another root (no relative form) stays as it is.
-  std::filesystem::path recorded = path;
+  namespace fs = std::filesystem;
+  // A file of the repository named by an absolute path (the CMF table or OCIO config a tool
+  // found by itself, FindRepoFile) is recorded relative to the working directory, like the inputs
+  // given relative: the same inputs baked in another checkout then give the same bytes
+  // (docs/design.md, "File conventions"). Any other path is recorded as given.
+  fs::path recorded = path;
   if (path.is_absolute()) {
     std::error_code ec;
-    const std::filesystem::path cwd = std::filesystem::current_path(ec);
-    if (!ec) {
-      // The working directory comes back with its symbolic links resolved: resolve the path's too.
-      const std::filesystem::path canonical = std::filesystem::weakly_canonical(path, ec);
-      const std::filesystem::path rel = ec ? std::filesystem::path() : canonical.lexically_proximate(cwd);
-      if (!rel.empty()) recorded = rel;
+    const fs::path cwd = fs::current_path(ec);  // symbolic links resolved, as RepoRoot's
+    const fs::path canonical = ec ? fs::path() : fs::weakly_canonical(path, ec);
+    const std::optional<fs::path> root = ec ? std::nullopt : RepoRoot();
+    if (root) {
+      const fs::path inside = canonical.lexically_relative(*root);
+      const bool in_repo = !inside.empty() && *inside.begin() != "..";
+      const fs::path rel = canonical.lexically_proximate(cwd);
+      if (in_repo && !rel.empty() && rel.is_relative()) recorded = rel;
     }
   }
   inputs.emplace_back(recorded.lexically_normal().generic_string(), HashFile(path));

@@ -30,6 +30,21 @@ std::optional<fs::path> FindUpwards(const fs::path& start, const fs::path& relat
   }
 }
 
+std::optional<fs::path> RepoRoot() {
+  const fs::path marker = fs::path("ocio") / "config.ocio";
+  std::optional<fs::path> found;
+  if (std::optional<fs::path> exe_dir = ExecutableDir()) found = FindUpwards(*exe_dir, marker);
+  std::error_code ec;
+  if (!found) {
+    const fs::path cwd = fs::current_path(ec);
+    if (!ec) found = FindUpwards(cwd, marker);
+  }
+  if (!found) return std::nullopt;
+  fs::path root = fs::weakly_canonical(found->parent_path().parent_path(), ec);
+  if (ec) return std::nullopt;
+  return root;
+}
+
 fs::path FindRepoFile(const fs::path& relative) {
   std::string searched;
   if (std::optional<fs::path> exe_dir = ExecutableDir()) {

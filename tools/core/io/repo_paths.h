@@ -26,4 +26,8 @@ std::optional<std::filesystem::path> FindUpwards(const std::filesystem::path& st
 // Throws InputError naming `relative` and the folders searched when it is not found.
 std::filesystem::path FindRepoFile(const std::filesystem::path& relative);
 
+// The repository's folder (symbolic links resolved): where FindRepoFile finds ocio/config.ocio;
+// nullopt when there is none (a tool installed outside any checkout).
+std::optional<std::filesystem::path> RepoRoot();
+
 }  // namespace skybake
