@@ -58,12 +58,8 @@ struct OrdersSettings {
   int nt = 40;               // steps along a table ray
   int nss = 96;              // steps along an output view ray (single scattering)
   int fine = 256;            // pieces for optical depths along a ray
-  // Truncation cone per scattering component, between truncation_min_deg and truncation_deg: the
-  // smallest (in 0.5 deg steps) outside which the phase function falls by at most
-  // kPeakRatioPerInterval over one azimuth interval of the tables at every wavelength, so that what
-  // the kernel must integrate is no sharper than its grid resolves ("Truncation cone" in
-  // docs/sky-methods.md). A continental aerosol gets the smallest cone, a cloud droplet's
-  // diffraction peak a wider one.
+  // Truncation cone per scattering component, between truncation_min_deg and truncation_deg
+  // (chosen in PrepareMedium; "Truncation cone per component" in docs/sky-methods.md).
   double truncation_deg = 5.0;
   double truncation_min_deg = 0.0;  // 0: the same as truncation_deg (one cone for all)
   double tau_cap = 12.0;     // optical depth beyond which a table ray's steps follow distance only
@@ -479,7 +475,8 @@ void OrdersMethod::PrepareMedium() {
   // Each component's truncation cone (OrdersSettings::truncation_min_deg): the smallest angle in
   // 0.5 deg steps from the minimum up to truncation_deg at which, for every wavelength, the phase
   // function one azimuth interval further out is no more than kPeakRatioPerInterval times lower.
-  // Measured at 550 nm (docs/sky-methods.md "Truncation cone"): the continental aerosol falls 4.3x
+  // So what the kernel must integrate is no sharper than its grid resolves. Measured at 550 nm
+  // (docs/sky-methods.md "Truncation cone per component"): the continental aerosol falls 4.3x
   // from 1 deg to 8.5 deg (1 deg cone at high's 24 azimuths), a 10 um water droplet 210x from 1 deg
   // and 6.9x from 3 deg (3 deg cone).
   constexpr double kPeakRatioPerInterval = 10.0;
