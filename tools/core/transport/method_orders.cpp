@@ -478,10 +478,10 @@ void OrdersMethod::PrepareMedium() {
   // Each component's truncation cone (OrdersSettings::truncation_min_deg): the smallest angle in
   // 0.5 deg steps from the minimum up to truncation_deg at which, for every wavelength, the phase
   // function one azimuth interval further out is no more than kPeakRatioPerInterval times lower.
-  // So what the kernel must integrate is no sharper than its grid resolves. Measured at 550 nm
-  // (docs/sky-methods.md "Truncation cone per component"): the continental aerosol falls 4.3x
-  // from 1 deg to 8.5 deg (1 deg cone at high's 24 azimuths), a 10 um water droplet 210x from 1 deg
-  // and 6.9x from 3 deg (3 deg cone).
+  // So what the kernel must integrate is no sharper than its grid resolves. At 550 nm and high's
+  // azimuth interval (7.5 deg with the 24 azimuths this was measured with, 5 deg with 36) the
+  // continental aerosol falls 3-4.5x from 1 deg (1 deg cone), a 10 um water droplet over 100x from
+  // 1 deg and 5-7x from 3 deg (3 deg cone; docs/sky-methods.md "Truncation cone per component").
   constexpr double kPeakRatioPerInterval = 10.0;
   const double interval_deg = 180.0 / s_.nphi;  // azimuth nodes at cell centres, pi / nphi apart
   cone_deg_.assign(nc_, s_.truncation_deg);
