@@ -73,7 +73,10 @@ struct OrdersSettings {
   // same table size and cost as 96 and 0.1 deg.
   int sun_nr = 96;
   double sun_low_step_deg = 0.1;
-  double loglin_from_deg = 90.0;  // sun-node intervals from here on: J blended log-linearly in the sun angle (> 180: never)
+  // Sun-node intervals from here on: J blended log-linearly in the sun angle (> 180: never). 85
+  // since 2026-11-24 (90 before), with the sun nodes from 80 to 90 deg 1 deg apart (2.5 before):
+  // the sun on the horizon, "The sun on the horizon" in docs/sky-methods.md.
+  double loglin_from_deg = 85.0;
   double view_power = 2.0;   // view nodes: power of the node spacing in angle from the horizon
   bool normalise = true;     // kernel rows scaled to conserve energy
   bool azimuth_even = true;  // azimuth blends even about the sun's plane (phi^2 near 0 and pi)
@@ -187,13 +190,17 @@ OrdersSettings SettingsFor(const SkyMethodOptions& o) {
   if (o.view_steps > 0) s.nss = o.view_steps;
   if (o.orders > 0) s.max_orders = o.orders;
   if (o.order_tolerance > 0) s.tolerance = o.order_tolerance;
-  // Sun zenith nodes: every 10 deg up to 80, then 2.5 deg to 90, 1 deg through twilight to
+  // Sun zenith nodes: every 10 deg up to 80, then 1 deg through the low sun and twilight to
   // 110, then 112, 115, 120 (beyond: no sunlight reaches the atmosphere's sunlit part that
-  // matters; J is taken as 0). "high" halves the twilight step.
+  // matters; J is taken as 0). "high" halves the twilight step. From 80 to 90 deg the step was
+  // 2.5 deg until 2026-11-24: a table ray's sources were blended linearly between 87.5 and 90
+  // deg, where they fall steeply and convexly, and with the sun on the horizon the clear sky
+  // 0.5 deg above the horizon, 40 deg from the sun's azimuth, came out +4.0 % (high; path
+  // tracer 387.1 cd/m2 +- 0.37 %); 1 deg with the log-linear blend from 85 deg: +0.1 %.
   int sun_step = 10;
   get("sun_step_deg", &sun_step);
   for (double a = 0; a < 80; a += sun_step) s.sun_deg.push_back(a);
-  int low10 = 25;
+  int low10 = 10;
   get("low_sun_step_x10", &low10);
   for (double a = 80; a < 90 - 1e-9; a += low10 / 10.0) s.sun_deg.push_back(a);
   double tw = o.quality == "high" ? 0.5 : 1.0;
@@ -1146,7 +1153,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
   jms_.assign(cells * nw_, 0.0f);
   const size_t nd = nu_ * nphi;  // directions per (radius, sun)
   std::vector<float> E(ns_ * nw_);
-  double prev_norm = 0.0, prev_ratio = -1.0;
+  double prev_norm = 0.0, prev_ratio = -1.0, prev_prev_ratio = -1.0;
   bool last_order_tail = false;
   const size_t wref = nw_ / 2;
   // The scattering step: J = sum_c sigma_s*_c P*_c applied to a radiance table, per radius a
@@ -1762,9 +1769,13 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
     // short of the converged sum). 30 % was tried with the energy-conserving step weights: within
     // 0.3 % on cloudy4/5 (5 and 18 orders fewer), but on the hazed sky with 24 azimuths and a 3 deg
     // cone it took the tail at order 4-5 and the horizon came out 11 % dark (docs/sky-methods.md).
+    // d_rho is the larger of the last two changes of the ratio (since 2026-11-24): with one, a
+    // ratio passing an extremum looked settled - the hazed sky with 1 deg sun nodes from 80 to
+    // 90 deg had ratios 0.521, 0.503, 0.503 at orders 3-5, took the tail at order 5 and came out
+    // 2.2 % RMS at sun 70 deg instead of 0.6 % (its ratio went on to 0.52 by order 12).
     const bool settled = ratio > 0.0 && ratio < 1.0 && prev_ratio > 0.0;
-    const double tail_error =
-        settled ? last_fraction_ * std::abs(ratio - prev_ratio) / ((1.0 - ratio) * (1.0 - ratio)) : 1.0;
+    const double d_rho = std::max(std::abs(ratio - prev_ratio), prev_prev_ratio > 0.0 ? std::abs(prev_ratio - prev_prev_ratio) : 1.0);
+    const double tail_error = settled ? last_fraction_ * d_rho / ((1.0 - ratio) * (1.0 - ratio)) : 1.0;
     const double tail_share = settled ? last_fraction_ * ratio / (1.0 - ratio) : 1.0;
     if (settled && s_.early_tail && order >= 4 && tail_error < s_.tolerance && tail_share <= s_.tail_share_max) last_order_tail = true;
     if (last_order_tail || (order == s_.max_orders && settled && std::abs(ratio - prev_ratio) < 0.02)) {
@@ -1794,6 +1805,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
       tail_ = true;
       break;
     }
+    prev_prev_ratio = prev_ratio;
     prev_ratio = ratio;
     prev_norm = norm;
   }
