@@ -195,7 +195,7 @@ OrdersSettings SettingsFor(const SkyMethodOptions& o) {
   // matters; J is taken as 0). "high" halves the twilight step. From 80 to 90 deg the step was
   // 2.5 deg until 2026-11-24: a table ray's sources were blended linearly between 87.5 and 90
   // deg, where they fall steeply and convexly, and with the sun on the horizon the clear sky
-  // 0.5 deg above the horizon, 40 deg from the sun's azimuth, came out +4.0 % (high; path
+  // 0.5 deg above the horizon, 40 deg from the sun's azimuth, came out +4.7 % (high; path
   // tracer 387.1 cd/m2 +- 0.37 %); 1 deg with the log-linear blend from 85 deg: +0.1 %.
   int sun_step = 10;
   get("sun_step_deg", &sun_step);
@@ -1777,7 +1777,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
     const double d_rho = std::max(std::abs(ratio - prev_ratio), prev_prev_ratio > 0.0 ? std::abs(prev_ratio - prev_prev_ratio) : 1.0);
     const double tail_error = settled ? last_fraction_ * d_rho / ((1.0 - ratio) * (1.0 - ratio)) : 1.0;
     const double tail_share = settled ? last_fraction_ * ratio / (1.0 - ratio) : 1.0;
-    if (settled && s_.early_tail && order >= 4 && tail_error < s_.tolerance && tail_share <= s_.tail_share_max) last_order_tail = true;
+    if (settled && s_.early_tail && order >= 5 && tail_error < s_.tolerance && tail_share <= s_.tail_share_max) last_order_tail = true;
     if (last_order_tail || (order == s_.max_orders && settled && std::abs(ratio - prev_ratio) < 0.02)) {
       // Geometric tail: sum_{k>n} L_k ~ L_n rho / (1 - rho), with rho per table element (the
       // horizon and the shadowed sky decay more slowly than the observer's average: with one
