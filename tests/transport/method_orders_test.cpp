@@ -183,6 +183,30 @@ TEST(MethodOrders, HighAtTheDaylightTargetOnTheHazedSky) {
   }
 }
 
+// `high` with the sun on the horizon (sun zenith 90 deg), clear sky, on the horizon band 40 deg from
+// the sun's azimuth, 0.5 and 3 deg above the horizon, where the table build's sun nodes from 80 to
+// 90 deg 2.5 deg apart made it +4.7 / +2.6 % (0.3-0.37 % references, 48 wavelengths; since
+// 2026-11-24 1 deg with the log-linear blend from 85 deg: +0.13 / +0.30 %, docs/sky-methods.md "The
+// sun on the horizon"). Here ~0.85 % references (the path tracer's default cap of 2^20 paths) on
+// the 10 nm grid, bound: the issue's 2 % max; measured +0.84 / -0.35 % (95 s on 2 busy cores).
+TEST(MethodOrders, HighWithTheSunOnTheHorizonOnTheClearSky) {
+  SceneOptions so;
+  so.step_nm = 10.0;
+  const TestScene sc = LoadTestScene("clear", so);
+  SkyMethodOptions o;
+  o.quality = "high";
+  const std::unique_ptr<SkyMethod> orders = MakeSkyMethod("orders", sc.model, o, {});
+  const std::vector<std::array<double, 3>> dirs = {Dir(89.5, 40), Dir(87, 40)};
+  const std::vector<ColorEstimate> ref = PathY(sc, 90.0, dirs, 0.008);
+  const std::vector<double> y = MethodY(sc, *orders, 90.0, dirs);
+  for (size_t d = 0; d < y.size(); ++d) {
+    const double e = y[d] / ref[d].xyz[1] - 1.0;
+    std::printf("high vs path, clear sun 90 deg, dir %zu: %+.2f %% (path +- %.2f %%)\n", d, 100.0 * e,
+                100.0 * ref[d].xyz_stderr[1] / ref[d].xyz[1]);
+    EXPECT_LT(std::abs(e), 0.02) << "dir " << d;
+  }
+}
+
 // The second order alone - `orders` with 2 orders against the path tracer counting scatterings up
 // to 2 - isolates the scattering kernel, which is where the hazed sky's error comes from
 // (docs/sky-methods.md "Scattering kernel"): hazed, sun 70 deg, five directions (the zenith, 10
