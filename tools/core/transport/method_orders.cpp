@@ -91,6 +91,9 @@ struct OrdersSettings {
   // columns); false: the (nd x nd) matrix, the slow and plain form the modal one is tested
   // against ("Scattering kernel" in docs/sky-methods.md).
   bool kernel_modal = true;
+  // The transport's gather by families (radius/view corners blended once per step for all sun and
+  // azimuth nodes); false: cell by cell, 16 corners each (the plain form).
+  bool gather_split = true;
   // A table ray's step weights J by the exact int T* sigma_t* dt = T*(t0) (1 - e^-dtau) times the
   // single-scattering albedo at the step's point (conserves energy: the weights of a lossless
   // medium sum to 1 - T*(end)); false: int T* dt exactly times sigma_s* at the point, which
@@ -175,6 +178,7 @@ OrdersSettings SettingsFor(const SkyMethodOptions& o) {
   get_flag("scaled_sun_exact", &s.scaled_sun_exact);
   get_flag("tau_centroid", &s.tau_centroid);
   get_flag("kernel_modal", &s.kernel_modal);
+  get_flag("gather_split", &s.gather_split);
 
   int loglin = 0;
   get("loglin_from_deg", &loglin);
@@ -1664,7 +1668,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
       }
     });
   };
-  auto transport = [&](const std::vector<float>& Jin, const std::vector<float>& Lin, std::vector<float>* Lout) {
+  auto transport_cells = [&](const std::vector<float>& Jin, const std::vector<float>& Lin, std::vector<float>* Lout) {
     ground_irradiance(Lin, &E);
     build_cfac(Jin);
     // L_n = int T* J_n dt + ground reflection of E_{n-1}.
@@ -1735,6 +1739,118 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
         }
       }
     });
+  };
+  // The same transport by families (since 2026-11-24, `table_size` key `gather_split`, 0 = the
+  // cell-by-cell form above, which the test compares against): all cells of a family (radius
+  // node, view node) share each step's point and so its 4 radius/view corners. Per step, the
+  // radius/view blend of J is formed once for every sun and azimuth node (a slab of ns x nphi x nw,
+  // which stays in cache), and each cell then blends 4 sun/azimuth corners of the slab: 4 + 4
+  // products per wavelength per cell instead of 16, and the cells' reads go to the slab instead of
+  // 16 scattered table rows. The same sums in another order: the result differs from the
+  // cell-by-cell form by float rounding (MethodOrders.SplitGatherIsTheCellGather).
+  auto transport_split = [&](const std::vector<float>& Jin, const std::vector<float>& Lin, std::vector<float>* Lout) {
+    ground_irradiance(Lin, &E);
+    build_cfac(Jin);
+    const size_t plane = ns_ * nphi;  // cells of one family
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nr * nu_, 1), [&](const tbb::blocked_range<size_t>& rg) {
+      // slab[(s * nphi + q) * nw + w]: sum over the 4 radius/view corners; lo / hi: the lower and
+      // the upper radius's 2 corners apart (twilight's log-linear factor), for s >= loglin_first.
+      std::vector<float> slab(plane * nw_), lo(plane * nw_), hi(plane * nw_), acc(plane * nw_), jv(nw_), jv2(nw_), eg(nw_);
+      std::vector<SunAzimuth> pts(plane);
+      for (size_t fi = rg.begin(); fi != rg.end(); ++fi) {
+        const size_t ri = fi / nu_, k = fi % nu_;
+        const Family& f = fam[fi];
+        const double r = radius_[ri];
+        std::fill(acc.begin(), acc.end(), 0.0f);
+        for (size_t m = 0; m < f.t.size(); ++m) {
+          // The cells' sun/azimuth positions at this step, and the sun nodes they read.
+          size_t s_lo = ns_, s_hi = 0;
+          for (size_t si = 0; si < ns_; ++si) {
+            for (size_t q = 0; q < nphi; ++q) {
+              SunAzimuth p;
+              if (!sun_az.empty()) {
+                p = sun_az[Cell(ri, si, k, q) * nt + m];
+              } else {
+                double mu, nu;
+                cell_geometry(ri, si, k, q, &mu, &nu);
+                p = step_sun_azimuth(f, m, r, sun_theta_rad_[si], nu);
+              }
+              pts[si * nphi + q] = p;
+              if (p.si == kNoSun) continue;
+              s_lo = std::min<size_t>(s_lo, p.si);
+              s_hi = std::max<size_t>(s_hi, std::min<size_t>(p.si + 1, ns_ - 1));
+            }
+          }
+          if (s_lo > s_hi) continue;
+          const Family::Corners& c = f.rc[m];
+          for (size_t s = s_lo; s <= s_hi; ++s) {
+            const size_t so = s * nu_ * nphi;
+            const float* v[4];
+            for (int a = 0; a < 4; ++a) v[a] = &Jin[(c.off[a] + so) * nw_];
+            const size_t n = nphi * nw_;
+            float* out = &slab[s * n];
+            if (s < loglin_first) {
+              Gather16(v, c.w, 0, 4, n, out);
+            } else {
+              Gather16(v, c.w, 0, 2, n, &lo[s * n]);
+              Gather16(v, c.w, 2, 4, n, &hi[s * n]);
+              for (size_t x = 0; x < n; ++x) out[x] = lo[s * n + x] + hi[s * n + x];
+            }
+          }
+          const float* gm = &f.g[m * nw_];
+          for (size_t cell = 0; cell < plane; ++cell) {
+            const SunAzimuth& p = pts[cell];
+            if (p.si == kNoSun) continue;
+            const size_t so = static_cast<size_t>(p.si) * nphi + p.q0;
+            const float ws[4] = {(1.0f - p.ts) * (1.0f - p.tq), (1.0f - p.ts) * p.tq, p.ts * (1.0f - p.tq), p.ts * p.tq};
+            // A corner of weight 0 reads the first one (it may lie past the table's end).
+            const size_t sofs[4] = {so, ws[1] != 0.0f ? so + 1 : so, ws[2] != 0.0f ? so + nphi : so,
+                                    ws[3] != 0.0f ? so + nphi + 1 : so};
+            const bool loglin = p.si >= loglin_first && p.ts > 0.0f;
+            float* jvp = jv.data();
+            if (!loglin) {
+              const float* v[4] = {&slab[sofs[0] * nw_], &slab[sofs[1] * nw_], &slab[sofs[2] * nw_], &slab[sofs[3] * nw_]};
+              Gather16(v, ws, 0, 4, nw_, jvp);
+            } else {
+              const float* vl[4] = {&lo[sofs[0] * nw_], &lo[sofs[1] * nw_], &lo[sofs[2] * nw_], &lo[sofs[3] * nw_]};
+              const float* vh[4] = {&hi[sofs[0] * nw_], &hi[sofs[1] * nw_], &hi[sofs[2] * nw_], &hi[sofs[3] * nw_]};
+              Gather16(vl, ws, 0, 4, nw_, jvp);
+              Gather16(vh, ws, 0, 4, nw_, jv2.data());
+              const float fb = p.ts * kLogBins;
+              const size_t b0 = std::min(static_cast<size_t>(fb), kLogBins - 1);
+              const float tb = fb - static_cast<float>(b0);
+              const size_t r0 = f.rv[m].ri, r1 = std::min(r0 + 1, nr - 1);
+              const float* c00 = &cfac[((r0 * ns_ + p.si) * (kLogBins + 1) + b0) * nw_];
+              const float* c10 = &cfac[((r1 * ns_ + p.si) * (kLogBins + 1) + b0) * nw_];
+              for (size_t w = 0; w < nw_; ++w) {
+                const float f0 = c00[w] + (c00[w + nw_] - c00[w]) * tb, f1 = c10[w] + (c10[w + nw_] - c10[w]) * tb;
+                jvp[w] = jvp[w] * f0 + jv2[w] * f1;
+              }
+            }
+            float* a = &acc[cell * nw_];
+            for (size_t w = 0; w < nw_; ++w) a[w] += gm[w] * jvp[w];
+          }
+        }
+        for (size_t si = 0; si < ns_; ++si) {
+          const double ts = sun_theta_rad_[si];
+          for (size_t q = 0; q < nphi; ++q) {
+            float* a = &acc[(si * nphi + q) * nw_];
+            if (f.ground) {
+              double mu, nu;
+              cell_geometry(ri, si, k, q, &mu, &nu);
+              const double mus_g = (r * std::cos(ts) + f.d * nu) / R;
+              interp_E(E, std::acos(std::clamp(mus_g, -1.0, 1.0)), eg.data());
+              for (size_t w = 0; w < nw_; ++w) a[w] += f.trans_end[w] * static_cast<float>(albedo_[w] / kPi) * eg[w];
+            }
+            std::copy(a, a + nw_, &(*Lout)[Cell(ri, si, k, q) * nw_]);
+          }
+        }
+      }
+    });
+  };
+  auto transport = [&](const std::vector<float>& Jin, const std::vector<float>& Lin, std::vector<float>* Lout) {
+    if (s_.gather_split) transport_split(Jin, Lin, Lout);
+    else transport_cells(Jin, Lin, Lout);
   };
   for (int order = 2; order <= s_.max_orders; ++order) {
     ReportProgress(progress, fmt::format("orders: order {}", order), 0.0);
