@@ -27,14 +27,16 @@ ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 
 
 def luts_section(pipeline):
-    """(method, quality, time_mapping, spectral_stride, [(sky, size)]) from pipeline.yaml's luts section."""
+    """(method, quality, time_mapping, spectral_stride, [(sky, size, quality)]) from pipeline.yaml's luts section
+    (a sky's own quality, if it names one, else the section's)."""
     text = open(pipeline).read()
     sec = text[text.index("\nluts:"):]
     sec = sec[:re.search(r"\n\S", sec[1:]).start() + 1]
     get = lambda k, d: (re.search(r"\n  %s: *([^\s#]+)" % k, sec) or [None, d])[1]
-    skies = re.findall(r"\{atmosphere: *(\w+), *size: *(\d+x\d+)\}", sec)
-    return (get("method", "orders"), get("quality", "medium"), get("time_mapping", "gt7-quadratic"),
-            get("spectral_stride", "1"), skies)
+    quality = get("quality", "medium")
+    skies = [(a, size, q or quality)
+             for a, size, q in re.findall(r"\{atmosphere: *(\w+), *size: *(\d+x\d+)(?:, *quality: *(\w+))?\}", sec)]
+    return (get("method", "orders"), quality, get("time_mapping", "gt7-quadratic"), get("spectral_stride", "1"), skies)
 
 
 def timed(args, cwd):
@@ -62,7 +64,7 @@ def main():
     if a.spectral_stride:
         stride = a.spectral_stride
     if a.size:
-        skies = [(sky, a.size) for sky, _ in skies]
+        skies = [(sky, a.size, q) for sky, _, q in skies]
     if a.skies:
         keep = a.skies.split(",")
         skies = [s for s in skies if s[0] in keep]
@@ -72,11 +74,11 @@ def main():
     nwl = len(range(*[int(float(x)) for x in a.wavelengths.split(":")])) + 1
     print("sky-render --method %s --quality %s --time-mapping %s --spectral-stride %s, %d wavelengths (%s nm), %d cpus"
           % (method, quality, time_mapping, stride, nwl, a.wavelengths, os.cpu_count()))
-    print("%-8s %-7s %8s %12s %s" % ("sky", "size", "build_s", "render_s", "(wall s at threads " + a.threads + ")"))
+    print("%-8s %-7s %-7s %8s %12s %s" % ("sky", "size", "quality", "build_s", "render_s", "(wall s at threads " + a.threads + ")"))
     totals = {t: 0.0 for t in threads}
-    for sky, size in skies:
+    for sky, size, sky_quality in skies:
         base = [os.path.join(os.path.abspath(a.bin), "sky-render"), "--quiet", "render", "--method", method,
-                "--quality", quality, "--profiles", "%s/profiles.exr" % sky, "--mie-dir", "mie",
+                "--quality", sky_quality, "--profiles", "%s/profiles.exr" % sky, "--mie-dir", "mie",
                 "--wavelengths", a.wavelengths, "--mapping", "gt7", "--time-mapping", time_mapping,
                 "--spectral-stride", stride]
         comp = "%s/components/render.yaml" % sky
@@ -88,7 +90,7 @@ def main():
             totals[t] += w
             walls.append(w)
         same = len({open(os.path.join(a.work, "%s_t%d.exr" % (sky, t)), "rb").read() for t in threads}) == 1
-        print("%-8s %-7s %8.1f %12s %s" % (sky, size, build, " ".join("%.1f" % w for w in walls),
+        print("%-8s %-7s %-7s %8.1f %12s %s" % (sky, size, sky_quality, build, " ".join("%.1f" % w for w in walls),
                                            "same bytes" if same else "BYTES DIFFER between thread counts"))
     for t in threads:
         print("set total at %d thread%s: %.1f s" % (t, "s" if t > 1 else "", totals[t]))

@@ -7,7 +7,7 @@
 // Only with a `luts` section in pipeline.yaml:
 //   luts:
 //     method: orders               # sky-render method of the LUT renders (docs/sky-methods.md)
-//     quality: medium              # its quality preset
+//     quality: medium              # its quality preset (a sky may name its own: below)
 //     spectral_stride: 2           # the method on every 2nd wavelength, transfer interpolated (1 = all)
 //     time_mapping: gt7-quadratic  # or gt7 (the talk's; docs/lut-pack.md), optionally ":<upper>+<lower>"
 //     sky_exposure_stops: auto     # or N: sky texels store cd/m^2 x 2^N (auto: per texture, no clamping)
@@ -15,6 +15,7 @@
 //     skies:                       # the basis skies of the set, in row order of the other LUTs
 //       - {atmosphere: clear, size: 32x128}
 //       - {atmosphere: cloudy0, size: 16x64}
+//       - {atmosphere: hazed, size: 32x128, quality: high}  # this sky's quality instead of the section's
 // Each render edge depends on its atmosphere's render component (written by the sky-render
 // stage), profiles and Mie tables, so an edit to one atmosphere re-renders only its LUT and re-runs
 // the pack edge, whose unchanged textures keep their bytes and times (write-if-changed + restat).
@@ -34,6 +35,7 @@ namespace {
 struct LutSky {
   std::string atmosphere;
   std::string size;
+  std::string quality;  // the section's unless the sky names its own
   FileLoc loc;
 };
 
@@ -76,7 +78,7 @@ class LutPackStage : public Stage {
     budget_mib_ = luts->NumberOr("budget_mib", NumberSpec::Positive("MiB"), budget_mib_);
     std::set<std::string> seen;
     for (const YamlNode& n : luts->Seq("skies")) {
-      YamlMap m = n.ToMap("a mapping {atmosphere: NAME, size: WxH}");
+      YamlMap m = n.ToMap("a mapping {atmosphere: NAME, size: WxH[, quality: low|medium|high]}");
       if (!m.valid()) continue;
       LutSky s;
       s.loc = n.loc();
@@ -88,6 +90,7 @@ class LutPackStage : public Stage {
         m.Get("size")->ErrorExpected("WxH with sides from 2 to 4096, e.g. 32x128");
       }
       s.size = size;
+      s.quality = m.ChoiceOr("quality", {"low", "medium", "high"}, quality_);
       m.Finish();
       if (!s.atmosphere.empty() && !seen.insert(s.atmosphere).second) n.Error("basis sky '" + s.atmosphere + "' is listed twice");
       skies_.push_back(s);
@@ -138,7 +141,7 @@ class LutPackStage : public Stage {
       for (const std::string& p : particles) b.implicit_inputs.push_back(paths::MieTable(p).generic_string());
       std::string args = fmt::format("render --method {} --quality {} --profiles {} --mie-dir mie --wavelengths {}:{}:{} "
                                      "--mapping gt7 --size {} --time-mapping {}",
-                                     method_, quality_, paths::Profiles(a->name).generic_string(),
+                                     method_, s.quality, paths::Profiles(a->name).generic_string(),
                                      FormatExact(wl.min_nm), FormatExact(wl.max_nm), FormatExact(wl.step_nm), s.size,
                                      time_mapping_);
       if (spectral_stride_ > 1) args += fmt::format(" --spectral-stride {}", spectral_stride_);
