@@ -5,7 +5,7 @@ docs/sky-methods.md "orders"). Prints a table; writes only into its work folder.
 
   bench/sky_lut_bench.py [--bin build/release/bin] [--outputs outputs] [--pipeline pipeline.yaml]
                          [--skies clear,hazed,...] [--threads 1,2] [--work /tmp/sky_lut_bench]
-                         [--wavelengths 360:830:5] [--spectral-stride K] [--size WxH]
+                         [--wavelengths 360:830:5] [--spectral-stride K] [--size WxH] [--repeat N]
 
 Needs a baked outputs/ (profiles and Mie tables, from `scripts/bake`). For every basis sky of the
 pipeline's `luts` section, the exact LUT render the pipeline runs (sky-render render --method
@@ -59,6 +59,9 @@ def main():
     ap.add_argument("--wavelengths", default="360:830:5")
     ap.add_argument("--spectral-stride", default="", help="override luts.spectral_stride")
     ap.add_argument("--size", default="", help="render every sky at WxH instead of the pipeline's size")
+    ap.add_argument("--repeat", type=int, default=1,
+                    help="time each render N times and keep the shortest (a shared or virtual machine's "
+                         "speed drifts by ~20 %% between minutes)")
     a = ap.parse_args()
     method, quality, time_mapping, stride, skies = luts_section(a.pipeline)
     if a.spectral_stride:
@@ -72,8 +75,15 @@ def main():
     os.makedirs(a.work, exist_ok=True)
     out = os.path.abspath(a.outputs)
     nwl = len(range(*[int(float(x)) for x in a.wavelengths.split(":")])) + 1
-    print("sky-render --method %s --quality %s --time-mapping %s --spectral-stride %s, %d wavelengths (%s nm), %d cpus"
-          % (method, quality, time_mapping, stride, nwl, a.wavelengths, os.cpu_count()))
+    cpu = "?"
+    try:
+        with open("/proc/cpuinfo") as f:
+            cpu = next(l.split(":", 1)[1].strip() for l in f if l.startswith("model name"))
+    except (OSError, StopIteration):
+        pass
+    print("sky-render --method %s --quality %s --time-mapping %s --spectral-stride %s, %d wavelengths (%s nm), %d cpus (%s)%s"
+          % (method, quality, time_mapping, stride, nwl, a.wavelengths, os.cpu_count(), cpu,
+             ", shortest of %d" % a.repeat if a.repeat > 1 else ""))
     print("%-8s %-7s %-7s %8s %12s %s" % ("sky", "size", "quality", "build_s", "render_s", "(wall s at threads " + a.threads + ")"))
     totals = {t: 0.0 for t in threads}
     for sky, size, sky_quality in skies:
@@ -82,11 +92,12 @@ def main():
                 "--wavelengths", a.wavelengths, "--mapping", "gt7", "--time-mapping", time_mapping,
                 "--spectral-stride", stride]
         comp = "%s/components/render.yaml" % sky
-        build = timed(base + ["--size", "2x2", "--threads", str(max(threads)), "-o",
-                              os.path.join(a.work, sky + "_build.exr"), comp], out)
+        build = min(timed(base + ["--size", "2x2", "--threads", str(max(threads)), "-o",
+                                  os.path.join(a.work, sky + "_build.exr"), comp], out) for _ in range(a.repeat))
         walls = []
         for t in threads:
-            w = timed(base + ["--size", size, "--threads", str(t), "-o", os.path.join(a.work, "%s_t%d.exr" % (sky, t)), comp], out)
+            w = min(timed(base + ["--size", size, "--threads", str(t), "-o", os.path.join(a.work, "%s_t%d.exr" % (sky, t)), comp], out)
+                    for _ in range(a.repeat))
             totals[t] += w
             walls.append(w)
         same = len({open(os.path.join(a.work, "%s_t%d.exr" % (sky, t)), "rb").read() for t in threads}) == 1
