@@ -1675,6 +1675,21 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
       }
     });
   };
+  // Twilight's blend of a step's gathered J: jlo (the lower radius's corners) and jhi (the upper's)
+  // each times its factor C at the step's sun interval, interpolated between the kLogBins + 1
+  // tabulated t; the result in jlo.
+  auto log_blend = [&](const SunAzimuth& p, size_t r0, float* jlo, const float* jhi) {
+    const float fb = p.ts * kLogBins;
+    const size_t b0 = std::min(static_cast<size_t>(fb), kLogBins - 1);
+    const float tb = fb - static_cast<float>(b0);
+    const size_t r1 = std::min(r0 + 1, nr - 1);
+    const float* c00 = &cfac[((r0 * ns_ + p.si) * (kLogBins + 1) + b0) * nw_];
+    const float* c10 = &cfac[((r1 * ns_ + p.si) * (kLogBins + 1) + b0) * nw_];
+    for (size_t w = 0; w < nw_; ++w) {
+      const float f0 = c00[w] + (c00[w + nw_] - c00[w]) * tb, f1 = c10[w] + (c10[w + nw_] - c10[w]) * tb;
+      jlo[w] = jlo[w] * f0 + jhi[w] * f1;
+    }
+  };
   auto transport_cells = [&](const std::vector<float>& Jin, const std::vector<float>& Lin, std::vector<float>* Lout) {
     ground_irradiance(Lin, &E);
     build_cfac(Jin);
@@ -1722,18 +1737,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
               Gather16(v, wv, 0, 8, nw_, jvp);
               Gather16(v, wv, 8, 16, nw_, jv2.data());
             }
-            if (loglin) {
-              const float fb = p.ts * kLogBins;
-              const size_t b0 = std::min(static_cast<size_t>(fb), kLogBins - 1);
-              const float tb = fb - static_cast<float>(b0);
-              const size_t r0 = f.rv[m].ri, r1 = std::min(r0 + 1, nr - 1);
-              const float* c00 = &cfac[((r0 * ns_ + p.si) * (kLogBins + 1) + b0) * nw_];
-              const float* c10 = &cfac[((r1 * ns_ + p.si) * (kLogBins + 1) + b0) * nw_];
-              for (size_t w = 0; w < nw_; ++w) {
-                const float f0 = c00[w] + (c00[w + nw_] - c00[w]) * tb, f1 = c10[w] + (c10[w + nw_] - c10[w]) * tb;
-                jvp[w] = jvp[w] * f0 + jv2[w] * f1;
-              }
-            }
+            if (loglin) log_blend(p, f.rv[m].ri, jvp, jv2.data());
             const float* gm = &f.g[m * nw_];
             for (size_t w = 0; w < nw_; ++w) acc[w] += gm[w] * jvp[w];
           }
@@ -1823,16 +1827,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
               const float* vh[4] = {&hi[sofs[0] * nw_], &hi[sofs[1] * nw_], &hi[sofs[2] * nw_], &hi[sofs[3] * nw_]};
               Gather16(vl, ws, 0, 4, nw_, jvp);
               Gather16(vh, ws, 0, 4, nw_, jv2.data());
-              const float fb = p.ts * kLogBins;
-              const size_t b0 = std::min(static_cast<size_t>(fb), kLogBins - 1);
-              const float tb = fb - static_cast<float>(b0);
-              const size_t r0 = f.rv[m].ri, r1 = std::min(r0 + 1, nr - 1);
-              const float* c00 = &cfac[((r0 * ns_ + p.si) * (kLogBins + 1) + b0) * nw_];
-              const float* c10 = &cfac[((r1 * ns_ + p.si) * (kLogBins + 1) + b0) * nw_];
-              for (size_t w = 0; w < nw_; ++w) {
-                const float f0 = c00[w] + (c00[w + nw_] - c00[w]) * tb, f1 = c10[w] + (c10[w + nw_] - c10[w]) * tb;
-                jvp[w] = jvp[w] * f0 + jv2[w] * f1;
-              }
+              log_blend(p, f.rv[m].ri, jvp, jv2.data());
             }
             float* a = &acc[cell * nw_];
             for (size_t w = 0; w < nw_; ++w) a[w] += gm[w] * jvp[w];
