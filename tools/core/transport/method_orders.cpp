@@ -1987,8 +1987,8 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
     std::vector<double> s_at(static_cast<size_t>(nf) + 1);
     for (int p = 0; p <= nf; ++p) s_at[static_cast<size_t>(p)] = 0.5 * (cum[static_cast<size_t>(p)] / tau_tot + static_cast<double>(p) / nf);
     // t(s) for increasing s: the interval is found by walking on from the last one (the same
-    // interval as a search: s_at is strictly increasing; an IntervalLocator built per ray cost
-    // more than its few lookups).
+    // interval as a search, s_at being strictly increasing; no locator built per ray - its
+    // construction was 1.4 % of a hazed LUT's render).
     size_t s_i = 0;
     auto t_of_s = [&](double sv) {
       double u;
