@@ -32,6 +32,7 @@ def luts_section(pipeline):
     text = open(pipeline).read()
     sec = text[text.index("\nluts:"):]
     sec = sec[:re.search(r"\n\S", sec[1:]).start() + 1]
+    sec = re.sub(r"#[^\n]*", "", sec)  # comments may quote a sky mapping; only the YAML counts
     get = lambda k, d: (re.search(r"\n  %s: *([^\s#]+)" % k, sec) or [None, d])[1]
     quality = get("quality", "medium")
     skies = [(a, size, q or quality)
