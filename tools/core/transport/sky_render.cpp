@@ -1,5 +1,7 @@
 #include "transport/sky_render.h"
 
+#include "transport/ambient.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -182,6 +184,15 @@ SkyRenderResult RenderSkyDeterministic(const SkyMethod& method, const Atmosphere
     slice.xyz.assign(texels * 3, std::numeric_limits<float>::quiet_NaN());
     slice.y_stderr.assign(texels, 0.0f);
     slice.paths.assign(texels, 0.0f);
+    if (s.ambient) {
+      // transport/ambient.h: the hemisphere's grid and a cap around the sun. Before the texels,
+      // so that a method keeping view rays between calls (orders) keeps the grid's 16 rings,
+      // which recur in every slice (the same values either way).
+      const std::vector<double> E = AmbientIrradiance(method, s.observer_altitude_m, theta_s);
+      for (size_t w = 0; w < nw; ++w) {
+        for (size_t c = 0; c < 3; ++c) slice.ambient.xyz[c] += weights[w][c] * E[w];
+      }
+    }
     tbb::parallel_for(tbb::blocked_range<int>(0, H, 1), [&](const tbb::blocked_range<int>& rows) {
       for (int y = rows.begin(); y != rows.end(); ++y) {
         std::vector<std::array<double, 3>> dirs;
@@ -213,42 +224,6 @@ SkyRenderResult RenderSkyDeterministic(const SkyMethod& method, const Atmosphere
         if (progress) progress("sky radiance", static_cast<double>(n) / total);
       }
     });
-    if (s.ambient) {
-      // E = int_0^{2 pi} int_0^1 L mu dmu dphi = 2 int_0^pi ... (symmetric in phi).
-      static const double kX[8] = {0.0950125098376374, 0.2816035507792589, 0.4580167776572274, 0.6178762444026438,
-                                   0.7554044083550030, 0.8656312023878318, 0.9445750230732326, 0.9894009349916499};
-      static const double kW[8] = {0.1894506104550685, 0.1826034150449236, 0.1691565193950025, 0.1495959888165767,
-                                   0.1246289712555339, 0.0951585116824928, 0.0622535239386479, 0.0271524594117541};
-      std::vector<std::array<double, 3>> dirs;
-      std::vector<double> wt;
-      constexpr int kPhi = 32;
-      for (int k = 0; k < 16; ++k) {
-        const double mu = 0.5 + 0.5 * (k < 8 ? -kX[7 - k] : kX[k - 8]);
-        const double wmu = 0.5 * (k < 8 ? kW[7 - k] : kW[k - 8]);
-        for (int q = 0; q < kPhi; ++q) {
-          const double phi = kPi * (q + 0.5) / kPhi;
-          const double st = std::sqrt(std::max(0.0, 1.0 - mu * mu));
-          dirs.push_back({st * std::cos(phi), st * std::sin(phi), mu});
-          wt.push_back(2.0 * wmu * mu * kPi / kPhi);
-        }
-      }
-      // The 16 rings in parallel (rendered serially these 512 directions were a fifth of a sunny
-      // LUT's work on one thread: what capped the 1 -> 2 thread scaling at 1.6x), summed in
-      // ring order, so the bytes do not depend on the thread count.
-      std::vector<std::vector<double>> L(16);
-      tbb::parallel_for(size_t{0}, size_t{16}, [&](size_t k) {
-        const std::vector<std::array<double, 3>> ring(dirs.begin() + static_cast<std::ptrdiff_t>(k * kPhi),
-                                                      dirs.begin() + static_cast<std::ptrdiff_t>((k + 1) * kPhi));
-        method.Radiance(s.observer_altitude_m, theta_s, ring, &L[k]);
-      });
-      for (size_t d = 0; d < dirs.size(); ++d) {
-        const std::vector<double>& Lk = L[d / kPhi];
-        const size_t dk = d % kPhi;
-        for (size_t w = 0; w < nw; ++w) {
-          for (size_t c = 0; c < 3; ++c) slice.ambient.xyz[c] += wt[d] * weights[w][c] * Lk[dk * nw + w];
-        }
-      }
-    }
     result.slices.push_back(std::move(slice));
   }
   FillTransmittanceAndSun(m, weights, s, &result);

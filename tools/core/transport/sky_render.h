@@ -56,8 +56,7 @@ SkyRenderResult RenderSky(const PathTracer& tracer, const SkyRenderSettings& set
 
 // The same products from a deterministic method (transport/sky_method.h): standard errors and
 // path counts are 0; the ambient irradiance is the method's radiance integrated over the upper
-// hemisphere by Gauss-Legendre in cos(zenith) (16 nodes) x midpoint in azimuth (32 over the
-// half-circle, mirrored).
+// hemisphere by a grid and a cap around the sun (transport/ambient.h).
 SkyRenderResult RenderSkyDeterministic(const SkyMethod& method, const AtmosphereModel& model,
                                        const std::vector<std::array<double, 3>>& xyz_weights,
                                        const SkyRenderSettings& settings, const ProgressFn& progress);
