@@ -72,20 +72,28 @@ std::vector<double> AmbientIrradiance(const SkyMethod& method, double observer_a
   // The cap: one part per azimuth psi around the sun. d = cos(Th) s + sin(Th) (cos(psi) t + sin(psi) b)
   // with t = (cos ts, 0, -sin ts) (from the sun towards the horizon below it) and b = +y; its
   // mu = cos(Th) cos(ts) - sin(Th) cos(psi) sin(ts) reaches 0 at Th_h = atan2(cos ts, cos(psi) sin ts).
+  // Theta = end u^2 for u in [0, 1], end = the cap's radius or Th_h.
+  const std::array<double, 3> t{std::cos(ts), 0.0, -std::sin(ts)};
+  auto cap_end = [&](double psi) { return std::min(t2, std::atan2(std::cos(ts), std::cos(psi) * std::sin(ts))); };
+  auto cap_dir = [&](double th, double psi) {
+    std::array<double, 3> d;
+    for (int i = 0; i < 3; ++i) d[i] = std::cos(th) * s[i] + std::sin(th) * (std::cos(psi) * t[i] + (i == 1 ? std::sin(psi) : 0.0));
+    return d;
+  };
+  // mu dw W for the cap's point at u on [0, 1] (quadrature weight du) and azimuth weight dpsi.
+  auto cap_weight = [&](double end, double u, double du, double dpsi, double th, double mu) {
+    return 2.0 * du * (2.0 * end * u) * std::sin(th) * dpsi * mu * W(th);
+  };
   if (cap) {
-    const std::array<double, 3> t{std::cos(ts), 0.0, -std::sin(ts)};
     for (int j = 0; j < q.cap_psi; ++j) {
       Part p;
-      const double psi = kPi * (j + 0.5) / q.cap_psi;
-      const double cp = std::cos(psi), sp = std::sin(psi);
-      const double end = std::min(t2, std::atan2(std::cos(ts), cp * std::sin(ts)));
+      const double psi = kPi * (j + 0.5) / q.cap_psi, end = cap_end(psi);
       for (int k = 0; k < kGauss; ++k) {
-        const double u = g.x[k], th = end * u * u, dth = 2.0 * end * u;
-        std::array<double, 3> d;
-        for (int i = 0; i < 3; ++i) d[i] = std::cos(th) * s[i] + std::sin(th) * (cp * t[i] + (i == 1 ? sp : 0.0));
+        const double th = end * g.x[k] * g.x[k];
+        const std::array<double, 3> d = cap_dir(th, psi);
         if (d[2] <= 0.0) continue;
         p.dirs.push_back(d);
-        p.wt.push_back(2.0 * g.w[k] * dth * std::sin(th) * kPi / q.cap_psi * d[2] * W(th));
+        p.wt.push_back(cap_weight(end, g.x[k], g.w[k], kPi / q.cap_psi, th, d[2]));
       }
       parts.push_back(std::move(p));
     }
@@ -98,12 +106,10 @@ std::vector<double> AmbientIrradiance(const SkyMethod& method, double observer_a
     double exact = 0.0;
     constexpr int kPsi = 64, kV = 256;
     for (int j = 0; j < kPsi; ++j) {
-      const double psi = kPi * (j + 0.5) / kPsi;
-      const double end = std::min(t2, std::atan2(std::cos(ts), std::cos(psi) * std::sin(ts)));
+      const double psi = kPi * (j + 0.5) / kPsi, end = cap_end(psi);
       for (int k = 0; k < kV; ++k) {
         const double v = (k + 0.5) / kV, th = end * v * v;
-        const double mu = std::cos(th) * std::cos(ts) - std::sin(th) * std::cos(psi) * std::sin(ts);
-        exact += 2.0 * (2.0 * end * v / kV) * std::sin(th) * (kPi / kPsi) * std::max(0.0, mu) * W(th);
+        exact += cap_weight(end, v, 1.0 / kV, kPi / kPsi, th, std::max(0.0, cap_dir(th, psi)[2]));
       }
     }
     double sum_grid = 0.0, sum_cap = 0.0;
@@ -111,7 +117,7 @@ std::vector<double> AmbientIrradiance(const SkyMethod& method, double observer_a
       for (double w : parts[i].wt) (i < kGauss ? sum_grid : sum_cap) += w;
     }
     for (size_t i = 0; i < parts.size(); ++i) {
-      const double f = i < kGauss ? (kPi - exact) / sum_grid : exact / sum_cap;
+      const double f = i < kGauss ? (kPi - exact) / sum_grid : (sum_cap > 0.0 ? exact / sum_cap : 0.0);
       for (double& w : parts[i].wt) w *= f;
     }
   }
