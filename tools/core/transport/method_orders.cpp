@@ -114,6 +114,19 @@ struct OrdersSettings {
   // uniform medium, which for a step straddling a cloud's edge fell in the clear air and lost the
   // step's sources (docs/sky-methods.md "Step weights").
   bool tau_centroid = true;
+  // The output's exact single scattering (full phase) attenuated on the sun's path by the
+  // delta-scaled medium (Nakajima & Tanaka 1988's TMS correction: L = L1[P, T*] + L*_ms; the view's
+  // path: ss_scaled_view), in the sky and in view segments, when there are multiple-scattering
+  // orders; false, or max_orders 1: by the unscaled medium (the true first order). With the
+  // unscaled attenuation the light scattered into the truncation cone on the way - not scattered,
+  // in the delta-scaled problem - was counted by neither term: under a thin water cloud (cloudy1,
+  // tau 1, the droplets' 5 deg cone holding 45 % of their scattering) the sky came out 17-53 %
+  // dark against the path tracer (docs/sky-methods.md "TMS attenuation").
+  bool ss_scaled = true;
+  // The view path's part of it: 1 = scaled for the components whose cone holds at least
+  // kViewScaledFraction of their scattering (cloud droplets), unscaled for the rest; 2 = scaled
+  // for all; 0 = unscaled for all (docs/sky-methods.md "TMS attenuation").
+  int ss_scaled_view = 1;
   // Largest share of the total the geometric tail may have when taken early (see the stopping
   // rule in SolveMultipleScattering).
   double tail_share_max = 0.1;
@@ -184,6 +197,8 @@ OrdersSettings SettingsFor(const SkyMethodOptions& o) {
   get_flag("step_albedo", &s.step_albedo);
   get_flag("scaled_sun_exact", &s.scaled_sun_exact);
   get_flag("tau_centroid", &s.tau_centroid);
+  get_flag("ss_scaled", &s.ss_scaled);
+  get("ss_scaled_view", &s.ss_scaled_view);
   get_flag("kernel_modal", &s.kernel_modal);
   get_flag("gather_split", &s.gather_split);
 
@@ -271,6 +286,8 @@ class OrdersMethod : public SkyMethod {
   OrdersMethod(const AtmosphereModel& model, const SkyMethodOptions& options, const ProgressFn& progress)
       : m_(model), s_(SettingsFor(options)), nw_(model.wavelengths()) {
     observer_altitude_m_ = options.observer_altitude_m;
+    ss_scaled_ = s_.ss_scaled && s_.max_orders >= 2;
+    ss_scaled_view_ = ss_scaled_ && s_.ss_scaled_view > 0;
     PrepareMedium();
     BuildSunTables();
     BuildRadiusNodes();
@@ -283,19 +300,22 @@ class OrdersMethod : public SkyMethod {
     return fmt::format(
         "method: orders\nradius_nodes: {}\nview_nodes: {} up + {} down per altitude\nazimuth_nodes: {}\n"
         "sun_nodes: {}\nray_steps: {}\nview_steps: {}\ntruncation_deg: {}\nkernel: {}\norders_computed: {}\n"
-        "tail_extrapolated: {}\nlast_order_fraction: {:.3g}\ntolerance: {}\n",
+        "tail_extrapolated: {}\nlast_order_fraction: {:.3g}\ntolerance: {}\nsingle_scattering_attenuation: {}\n",
         radius_.size(), s_.nup, s_.ndn, s_.nphi, s_.sun_deg.size(), s_.nt, s_.nss, ConesText(),
         s_.kernel_sub > 0 ? fmt::format("basis-integrated, {} sub-intervals", s_.kernel_sub) : std::string("phase at the nodes"), orders_done_,
-        tail_ ? "true" : "false", last_fraction_, s_.tolerance);
+        tail_ ? "true" : "false", last_fraction_, s_.tolerance, ss_scaled_ ? "delta-scaled" : "unscaled");
   }
 
-  // "1 (rayleigh), 3 (aerosol.cloud)": each scattering component's truncation cone, deg.
+  // "1 (rayleigh, truncated fraction 0.000 at 570 nm), ...": each scattering component's truncation
+  // cone (deg) and the share of its scattering inside it at the grid's middle wavelength.
   std::string ConesText() const {
     std::string text;
     size_t c = 0;
     for (const MediumComponent& mc : m_.components) {
       if (!mc.phase) continue;
-      text += fmt::format("{}{:g} ({})", text.empty() ? "" : ", ", cone_deg_[c++], mc.name);
+      text += fmt::format("{}{:g} ({}, truncated fraction {:.3f} at {:g} nm)", text.empty() ? "" : ", ", cone_deg_[c], mc.name,
+                          f_[c * nw_ + nw_ / 2], m_.wavelength_nm[nw_ / 2]);
+      ++c;
     }
     return text;
   }
@@ -317,6 +337,8 @@ class OrdersMethod : public SkyMethod {
   void SigmaT(double z, bool scaled, float* out) const { SigmaT(m_.Locate(z), scaled, out); }
   void SigmaS(size_t c, double z, bool scaled, float* out) const { SigmaS(c, m_.Locate(z), scaled, out); }
   void SigmaT(const AtmosphereModel::Cell& cell, bool scaled, float* out) const;
+  // The output view ray's extinction (unscaled, or sigma_t_view_ with ss_scaled_view_).
+  void SigmaTView(const AtmosphereModel::Cell& cell, float* out) const;
   void SigmaS(size_t c, const AtmosphereModel::Cell& cell, bool scaled, float* out) const;
   // sigma_t at one wavelength (the step placement's reference).
   float SigmaTAt(double z, bool scaled, size_t w) const;
@@ -403,12 +425,15 @@ class OrdersMethod : public SkyMethod {
 
   const AtmosphereModel& m_;
   OrdersSettings s_;
+  bool ss_scaled_ = false;  // s_.ss_scaled with multiple-scattering orders (max_orders >= 2)
+  bool ss_scaled_view_ = false;  // the view ray's attenuation from sigma_t_view_
   const size_t nw_;
   double observer_altitude_m_ = 0.0;
   size_t nc_ = 0;  // scattering components
 
   // Medium per model level l: sigma_t[l*nw+w], sigma_t*[..], sigma_s_c[(c*nl+l)*nw+w], sigma_s*_c.
   std::vector<float> sigma_t_, sigma_t_star_, sigma_s_, sigma_s_star_;
+  std::vector<float> sigma_t_view_;  // the view ray's extinction with ss_scaled_view (see OrdersSettings)
   std::vector<std::shared_ptr<const PhaseModel>> phase_;  // per component
   std::vector<double> f_;                                   // truncated fraction [c*nw+w]
   std::vector<double> cone_deg_;                            // truncation cone per component, deg
@@ -547,8 +572,19 @@ void OrdersMethod::PrepareMedium() {
     }
   }
 
+  // The components whose view-ray attenuation is delta-scaled (OrdersSettings::ss_scaled_view):
+  // all (2), none (0), or (1) those whose cone holds at least a quarter of their scattering at the
+  // grid's middle wavelength - cloud droplets (10 um: ~0.5 in a 3-5 deg cone), not the aerosols
+  // (continental 0.015-0.025 in 5 deg), whose long horizontal view rays near the horizon the scaled
+  // attenuation made up to 1 % bright (docs/sky-methods.md "TMS attenuation").
+  constexpr double kViewScaledFraction = 0.25;
+  std::vector<bool> view_scaled(nc_, false);
+  for (size_t c = 0; c < nc_; ++c) {
+    view_scaled[c] = s_.ss_scaled_view == 2 || (s_.ss_scaled_view == 1 && f_[c * nw_ + nw_ / 2] >= kViewScaledFraction);
+  }
   sigma_t_.assign(nl * nw_, 0.0f);
   sigma_t_star_.assign(nl * nw_, 0.0f);
+  sigma_t_view_.assign(nl * nw_, 0.0f);
   sigma_s_.assign(nc_ * nl * nw_, 0.0f);
   sigma_s_star_.assign(nc_ * nl * nw_, 0.0f);
   for (size_t l = 0; l < nl; ++l) {
@@ -566,6 +602,7 @@ void OrdersMethod::PrepareMedium() {
           sigma_s_star_[(c * nl + l) * nw_ + w] = static_cast<float>(ss - trunc);
         }
         sigma_t_star_[l * nw_ + w] += static_cast<float>(ss + sa - trunc);
+        sigma_t_view_[l * nw_ + w] += static_cast<float>(ss + sa - (mc.phase && view_scaled[c] ? trunc : 0.0));
       }
       (void)cell;
       if (mc.phase) ++c;
@@ -584,6 +621,14 @@ void OrdersMethod::SigmaT(const AtmosphereModel::Cell& c, bool scaled, float* ou
   const std::vector<float>& s = scaled ? sigma_t_star_ : sigma_t_;
   const float* a = &s[c.i * nw_];
   const float* b = &s[(c.i + 1) * nw_];
+  const float t = static_cast<float>(c.t);
+  for (size_t w = 0; w < nw_; ++w) out[w] = a[w] + (b[w] - a[w]) * t;
+}
+
+void OrdersMethod::SigmaTView(const AtmosphereModel::Cell& c, float* out) const {
+  if (!ss_scaled_view_) return SigmaT(c, false, out);
+  const float* a = &sigma_t_view_[c.i * nw_];
+  const float* b = &sigma_t_view_[(c.i + 1) * nw_];
   const float t = static_cast<float>(c.t);
   for (size_t w = 0; w < nw_; ++w) out[w] = a[w] + (b[w] - a[w]) * t;
 }
@@ -2015,14 +2060,14 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
         const double tmid = 0.5 * (t_prev + t);
         const double rmid = std::sqrt(r * r + 2.0 * r * mu * tmid + tmid * tmid);
         const AtmosphereModel::Cell cmid = m_.Locate(rmid - R), cell = m_.Locate(rr - R);
-        SigmaT(cmid, false, st.data());
+        SigmaTView(cmid, st.data());
         for (size_t w = 0; w < nw_; ++w) tau[w] += st[w] * (t - t_prev);
         if (segment != nullptr) {
           SigmaT(cmid, true, st.data());
           for (size_t w = 0; w < nw_; ++w) tau_star[w] += st[w] * (t - t_prev);
         }
         t_prev = t;
-        ray.pts.push_back({t, rr, std::clamp((r * mu + t) / rr, -1.0, 1.0), SunRadius(rr, false)});
+        ray.pts.push_back({t, rr, std::clamp((r * mu + t) / rr, -1.0, 1.0), SunRadius(rr, ss_scaled_)});
         const float hw = static_cast<float>(segment == nullptr || segment->single_scattering ? 0.5 * h : 0.0);
         const size_t e0 = ray.e.size();
         ray.e.resize(e0 + nc_ * nw_);
@@ -2048,7 +2093,7 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
       // Finish the optical depth to the ground.
       const double tmid = 0.5 * (t_prev + length);
       const double rmid = std::sqrt(r * r + 2.0 * r * mu * tmid + tmid * tmid);
-      SigmaT(rmid - R, false, st.data());
+      SigmaTView(m_.Locate(rmid - R), st.data());
       for (size_t w = 0; w < nw_; ++w) ray.t_end[w] = static_cast<float>(std::exp(-(tau[w] + st[w] * (length - t_prev))));
     }
     if (segment == nullptr) {
@@ -2092,7 +2137,7 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
       const ViewPoint& pt = ray.pts[p];
       const double mus = (r * std::cos(ts) + pt.t * nu) / pt.rr;
       if (segment == nullptr || segment->single_scattering) {
-        SunTransmittanceAt(pt.sun_r, mus, false, tsun.data());
+        SunTransmittanceAt(pt.sun_r, mus, ss_scaled_, tsun.data());
         const float* e = &ray.e[p * nc_ * nw_];
         std::fill(st.begin(), st.end(), 0.0f);
         for (size_t c = 0; c < nc_; ++c) {
@@ -2132,7 +2177,7 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
       // The ground's first reflection of the sun.
       const double mus_g = (r * std::cos(ts) + std::max(0.0, ray.length) * nu) / R;
       if (mus_g > -0.5) {
-        SunTransmittance(R, mus_g, false, tsun.data());
+        SunTransmittance(R, mus_g, ss_scaled_, tsun.data());
         for (size_t w = 0; w < nw_; ++w) {
           acc[w] += static_cast<float>(ray.t_end[w] * albedo_[w] / kPi * sun_e_[w] * std::max(0.0, mus_g)) * tsun[w];
         }
