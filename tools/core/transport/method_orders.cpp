@@ -337,8 +337,10 @@ class OrdersMethod : public SkyMethod {
   void SigmaT(double z, bool scaled, float* out) const { SigmaT(m_.Locate(z), scaled, out); }
   void SigmaS(size_t c, double z, bool scaled, float* out) const { SigmaS(c, m_.Locate(z), scaled, out); }
   void SigmaT(const AtmosphereModel::Cell& cell, bool scaled, float* out) const;
-  // The output view ray's extinction (unscaled, or sigma_t_view_ with ss_scaled_view_).
+  // The output view ray's extinction: sigma_t_view_ (the unscaled one unless ss_scaled_view_).
   void SigmaTView(const AtmosphereModel::Cell& cell, float* out) const;
+  // A per-level table [l * nw + w] interpolated to a cell.
+  void LevelLerp(const std::vector<float>& s, const AtmosphereModel::Cell& cell, float* out) const;
   void SigmaS(size_t c, const AtmosphereModel::Cell& cell, bool scaled, float* out) const;
   // sigma_t at one wavelength (the step placement's reference).
   float SigmaTAt(double z, bool scaled, size_t w) const;
@@ -433,7 +435,7 @@ class OrdersMethod : public SkyMethod {
 
   // Medium per model level l: sigma_t[l*nw+w], sigma_t*[..], sigma_s_c[(c*nl+l)*nw+w], sigma_s*_c.
   std::vector<float> sigma_t_, sigma_t_star_, sigma_s_, sigma_s_star_;
-  std::vector<float> sigma_t_view_;  // the view ray's extinction with ss_scaled_view (see OrdersSettings)
+  std::vector<float> sigma_t_view_;  // the view ray's extinction (OrdersSettings::ss_scaled_view)
   std::vector<std::shared_ptr<const PhaseModel>> phase_;  // per component
   std::vector<double> f_;                                   // truncated fraction [c*nw+w]
   std::vector<double> cone_deg_;                            // truncation cone per component, deg
@@ -580,7 +582,7 @@ void OrdersMethod::PrepareMedium() {
   constexpr double kViewScaledFraction = 0.25;
   std::vector<bool> view_scaled(nc_, false);
   for (size_t c = 0; c < nc_; ++c) {
-    view_scaled[c] = s_.ss_scaled_view == 2 || (s_.ss_scaled_view == 1 && f_[c * nw_ + nw_ / 2] >= kViewScaledFraction);
+    view_scaled[c] = ss_scaled_view_ && (s_.ss_scaled_view == 2 || f_[c * nw_ + nw_ / 2] >= kViewScaledFraction);
   }
   sigma_t_.assign(nl * nw_, 0.0f);
   sigma_t_star_.assign(nl * nw_, 0.0f);
@@ -617,21 +619,18 @@ float OrdersMethod::SigmaTAt(double z, bool scaled, size_t w) const {
   return a + (b - a) * static_cast<float>(c.t);
 }
 
-void OrdersMethod::SigmaT(const AtmosphereModel::Cell& c, bool scaled, float* out) const {
-  const std::vector<float>& s = scaled ? sigma_t_star_ : sigma_t_;
+void OrdersMethod::LevelLerp(const std::vector<float>& s, const AtmosphereModel::Cell& c, float* out) const {
   const float* a = &s[c.i * nw_];
   const float* b = &s[(c.i + 1) * nw_];
   const float t = static_cast<float>(c.t);
   for (size_t w = 0; w < nw_; ++w) out[w] = a[w] + (b[w] - a[w]) * t;
 }
 
-void OrdersMethod::SigmaTView(const AtmosphereModel::Cell& c, float* out) const {
-  if (!ss_scaled_view_) return SigmaT(c, false, out);
-  const float* a = &sigma_t_view_[c.i * nw_];
-  const float* b = &sigma_t_view_[(c.i + 1) * nw_];
-  const float t = static_cast<float>(c.t);
-  for (size_t w = 0; w < nw_; ++w) out[w] = a[w] + (b[w] - a[w]) * t;
+void OrdersMethod::SigmaT(const AtmosphereModel::Cell& c, bool scaled, float* out) const {
+  LevelLerp(scaled ? sigma_t_star_ : sigma_t_, c, out);
 }
+
+void OrdersMethod::SigmaTView(const AtmosphereModel::Cell& c, float* out) const { LevelLerp(sigma_t_view_, c, out); }
 
 void OrdersMethod::SigmaS(size_t comp, const AtmosphereModel::Cell& c, bool scaled, float* out) const {
   const size_t nl = m_.levels();
