@@ -94,23 +94,6 @@ void AtmosphereModel::Finalize() {
   }
 }
 
-AtmosphereModel::Cell AtmosphereModel::Locate(double z) const {
-  const size_t nl = levels();
-  if (z <= altitude_m.front()) return {0, 0.0};
-  if (z >= altitude_m.back()) return {nl - 2, 1.0};
-  if (uniform_step_ > 0.0) {
-    const size_t i = std::min(static_cast<size_t>(z / uniform_step_), nl - 2);
-    return {i, std::clamp((z - altitude_m[i]) / (altitude_m[i + 1] - altitude_m[i]), 0.0, 1.0)};
-  }
-  const size_t i = level_locator_.Find(z);
-  return {i, (z - altitude_m[i]) / (altitude_m[i + 1] - altitude_m[i])};
-}
-
-double AtmosphereModel::Extinction(const Cell& c, size_t wl) const {
-  const size_t nw = wavelengths();
-  return extinction_[c.i * nw + wl] + (extinction_[(c.i + 1) * nw + wl] - extinction_[c.i * nw + wl]) * c.t;
-}
-
 double AtmosphereModel::Scattering(const Cell& c, size_t wl) const {
   const size_t nw = wavelengths();
   return scattering_[c.i * nw + wl] + (scattering_[(c.i + 1) * nw + wl] - scattering_[c.i * nw + wl]) * c.t;

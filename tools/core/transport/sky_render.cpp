@@ -50,14 +50,17 @@ void TransmittanceToSpace(const AtmosphereModel& m, double altitude_m, double ze
   // Every wavelength in one walk (the altitude located once per point); each wavelength's sum
   // runs in the same order as alone, so the values do not depend on how many are asked for.
   std::vector<double>& tau = *out;
+  std::vector<double> ext(nw);
   for (int p = 0; p < pieces; ++p) {
     const double c = (p + 0.5) * h;
     for (int k = 0; k < 2; ++k) {
+      const double wk = kW[k] * 0.5 * h;
       for (double sgn : {-1.0, 1.0}) {
         const double t = c + sgn * 0.5 * h * kX[k];
         const double r = std::sqrt(r0 * r0 + 2.0 * r0 * mu * t + t * t);
         const AtmosphereModel::Cell cell = m.Locate(r - m.bottom_radius_m);
-        for (size_t w = 0; w < nw; ++w) tau[w] += kW[k] * 0.5 * h * m.Extinction(cell, w0 + w);
+        m.Extinction(cell, w0, nw, ext.data());
+        for (size_t w = 0; w < nw; ++w) tau[w] += wk * ext[w];
       }
     }
   }
