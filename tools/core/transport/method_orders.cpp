@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -2225,12 +2226,19 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
         }
       }
     }
+    // Log-linear between the two sun nodes, a (b/a)^t, where both are positive normal floats and
+    // their ratio is within 1e+-30 (else linear). In float with ExpF/LogF, which vectorise: the
+    // double log, log and exp per texel and wavelength were 7 % of a clear LUT's render (the two
+    // agree to ~3e-7 relative).
+    const float tf = static_cast<float>(ls.t);
     for (size_t w = 0; w < nw_; ++w) {
-      double ms;
-      const double a = ms0[w], b = ms1[w];
-      if (a > 0.0 && b > 0.0) ms = std::exp(std::log(a) + (std::log(b) - std::log(a)) * ls.t);
-      else ms = a + (b - a) * ls.t;
-      (*out)[d * nw_ + w] = acc[w] + std::max(0.0, ms);
+      const float a = ms0[w], b = ms1[w];
+      const float ratio = b / a;
+      const float geo = a * ExpF(tf * LogF(ratio));
+      const float lin = a + (b - a) * tf;
+      const bool use_geo = a >= std::numeric_limits<float>::min() && b >= std::numeric_limits<float>::min() && ratio > 1e-30f && ratio < 1e30f;
+      const float ms = use_geo ? geo : lin;
+      (*out)[d * nw_ + w] = static_cast<double>(acc[w]) + static_cast<double>(std::max(0.0f, ms));
     }
   }
 }
