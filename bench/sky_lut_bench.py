@@ -10,8 +10,9 @@ docs/sky-methods.md "orders"). Prints a table; writes only into its work folder.
 Needs a baked outputs/ (profiles and Mie tables, from `scripts/bake`). For every basis sky of the
 pipeline's `luts` section, the exact LUT render the pipeline runs (sky-render render --method
 orders --mapping gt7 --time-mapping ... --size ...) is timed at each thread count, and once with
-a 2x2 mapping, which is the table build alone (the solve of the orders; the render of 2x2x64
-directions is negligible). The set's total at 2 threads is compared with the 60 s target, and
+a 2x2 mapping: what does not depend on the LUT's size - the tables (the solve of the orders,
+the sun tables), the ambient LUT's 640 directions per slice and the transmittance LUT; the
+texels of 2x2x64 are negligible. The set's total at 2 threads is compared with the 60 s target, and
 the scaling 1 -> 2 threads is printed (target >= 1.8x). --size WxH renders every sky at that size
 instead of the pipeline's (32x128 for all 8: the issue's literal reading of the set; the pipeline
 follows the GT7 talk's memory budget, 16x64 for the cloudy skies).
