@@ -2228,7 +2228,7 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
     }
     // Log-linear between the two sun nodes, a (b/a)^t, where both are positive normal floats and
     // their ratio is within 1e+-30 (else linear). In float with ExpF/LogF, which vectorise: the
-    // double log, log and exp per texel and wavelength were 7 % of a clear LUT's render (the two
+    // double log, log and exp per texel and wavelength were ~7 % of a hazed LUT's render (the two
     // agree to ~3e-7 relative).
     const float tf = static_cast<float>(ls.t);
     for (size_t w = 0; w < nw_; ++w) {
