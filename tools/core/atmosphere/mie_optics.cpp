@@ -19,6 +19,14 @@ class TabulatedMiePhase : public PhaseModel {
     const double p0 = table_->EvalPhase(b.i0, mu);
     return b.t == 0.0 ? p0 : p0 + (table_->EvalPhase(b.i1, mu) - p0) * b.t;
   }
+  void EvalAll(double mu, size_t n, double* out) const override {
+    const mie::MieTable::PhasePoint at = table_->LocatePhase(mu);  // once for every wavelength
+    for (size_t w = 0; w < n; ++w) {
+      const mie::MieTable::Bracket& b = brackets_[w];
+      const double p0 = table_->EvalPhase(b.i0, at);
+      out[w] = b.t == 0.0 ? p0 : p0 + (table_->EvalPhase(b.i1, at) - p0) * b.t;
+    }
+  }
   double SampleMu(size_t wl, double u) const override {
     const mie::MieTable::Bracket& b = brackets_[wl];
     if (b.t <= 0.0) return table_->SamplePhaseCosTheta(b.i0, u);

@@ -30,6 +30,11 @@ class PhaseModel {
  public:
   virtual ~PhaseModel() = default;
   virtual double Eval(size_t wl, double mu) const = 0;
+  // Eval(w, mu) for w = 0 .. n-1 into out (the same values); a model whose lookup in mu does not
+  // depend on the wavelength does it once (the tabulated Mie phase).
+  virtual void EvalAll(double mu, size_t n, double* out) const {
+    for (size_t w = 0; w < n; ++w) out[w] = Eval(w, mu);
+  }
   // mu distributed as 2 pi Eval(wl, mu) from a uniform u in [0, 1).
   virtual double SampleMu(size_t wl, double u) const = 0;
   virtual std::string Name() const = 0;

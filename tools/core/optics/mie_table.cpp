@@ -115,13 +115,15 @@ double MieTable::FinishPhase() {
   return worst;
 }
 
-double MieTable::EvalPhase(size_t wl, double cos_theta) const {
-  SKYBAKE_CHECK_LT(wl, ln_phase_.size());
+MieTable::PhasePoint MieTable::LocatePhase(double cos_theta) const {
   const double v = std::clamp(cos_theta, -1.0, 1.0);
   const size_t j = FindSegment(mu, v);
-  const double t = std::clamp((mu[j] - v) / dmu_[j], 0.0, 1.0);
-  const std::vector<double>& lp = ln_phase_[wl];
-  return std::exp(lp[j] + t * (lp[j + 1] - lp[j]));
+  return {j, std::clamp((mu[j] - v) / dmu_[j], 0.0, 1.0)};
+}
+
+double MieTable::EvalPhase(size_t wl, double cos_theta) const {
+  SKYBAKE_CHECK_LT(wl, ln_phase_.size());
+  return EvalPhase(wl, LocatePhase(cos_theta));
 }
 
 double MieTable::SamplePhaseCosTheta(size_t wl, double u) const {

@@ -17,6 +17,7 @@
 // picking one neighbour with the blend weight; SamplePhaseCosThetaAt).
 #pragma once
 
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -46,6 +47,17 @@ struct MieTable {
 
   // P(cos theta) at tabulated wavelength `wl`, sr^-1.
   double EvalPhase(size_t wl, double cos_theta) const;
+  // The angle grid's interval of cos theta and the position in it, the same for every wavelength:
+  // EvalPhase(wl, c) == EvalPhase(wl, LocatePhase(c)).
+  struct PhasePoint {
+    size_t j = 0;
+    double t = 0.0;
+  };
+  PhasePoint LocatePhase(double cos_theta) const;
+  double EvalPhase(size_t wl, const PhasePoint& at) const {
+    const std::vector<double>& lp = ln_phase_[wl];
+    return std::exp(lp[at.j] + at.t * (lp[at.j + 1] - lp[at.j]));
+  }
   // cos theta distributed as EvalPhase(wl, .) (times 2 pi d mu), from u in [0, 1).
   double SamplePhaseCosTheta(size_t wl, double u) const;
 

@@ -2004,7 +2004,7 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
   // Log-linear interpolation of the MS table in the sun angle (exact for exponential twilight decay).
   const Lerp ls = Locate(sun_theta_rad_, ts);
   std::vector<float> tsun(nw_), st(nw_), acc(nw_), ms0(nw_), ms1(nw_), pc(nc_ * nw_), jv(nw_), jv1(nw_), hwt(nw_);
-  std::vector<double> seg_ms(nw_);
+  std::vector<double> seg_ms(nw_), pv(nw_);
 
   // What along a view ray does not depend on the sun or the azimuth - the steps, the medium at
   // each point and its transmittance from the observer - is computed once per view zenith
@@ -2147,7 +2147,8 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
     // --- single scattering along the view ray (unscaled medium, full phase)
     for (size_t c = 0; c < nc_; ++c) {
       // The phase times the sun's irradiance (per direction, not per point).
-      for (size_t w = 0; w < nw_; ++w) pc[c * nw_ + w] = static_cast<float>(phase_[c]->Eval(w, nu) * sun_e_[w]);
+      phase_[c]->EvalAll(nu, nw_, pv.data());
+      for (size_t w = 0; w < nw_; ++w) pc[c * nw_ + w] = static_cast<float>(pv[w] * sun_e_[w]);
     }
     std::fill(acc.begin(), acc.end(), 0.0f);
     std::fill(seg_ms.begin(), seg_ms.end(), 0.0);
