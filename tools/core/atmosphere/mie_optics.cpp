@@ -14,18 +14,10 @@ class TabulatedMiePhase : public PhaseModel {
   TabulatedMiePhase(std::shared_ptr<const mie::MieTable> table, const WavelengthGrid& grid) : table_(std::move(table)) {
     for (size_t i = 0; i < grid.size(); ++i) brackets_.push_back(table_->BracketWavelength(grid[i]));
   }
-  double Eval(size_t wl, double mu) const override {
-    const mie::MieTable::Bracket& b = brackets_[wl];
-    const double p0 = table_->EvalPhase(b.i0, mu);
-    return b.t == 0.0 ? p0 : p0 + (table_->EvalPhase(b.i1, mu) - p0) * b.t;
-  }
+  double Eval(size_t wl, double mu) const override { return At(wl, table_->LocatePhase(mu)); }
   void EvalAll(double mu, size_t n, double* out) const override {
     const mie::MieTable::PhasePoint at = table_->LocatePhase(mu);  // once for every wavelength
-    for (size_t w = 0; w < n; ++w) {
-      const mie::MieTable::Bracket& b = brackets_[w];
-      const double p0 = table_->EvalPhase(b.i0, at);
-      out[w] = b.t == 0.0 ? p0 : p0 + (table_->EvalPhase(b.i1, at) - p0) * b.t;
-    }
+    for (size_t w = 0; w < n; ++w) out[w] = At(w, at);
   }
   double SampleMu(size_t wl, double u) const override {
     const mie::MieTable::Bracket& b = brackets_[wl];
@@ -36,6 +28,12 @@ class TabulatedMiePhase : public PhaseModel {
   std::string Name() const override { return "mie-tabulated(" + table_->particle + ")"; }
 
  private:
+  // The grid wavelength's phase at a located angle: its two table neighbours blended linearly.
+  double At(size_t wl, const mie::MieTable::PhasePoint& at) const {
+    const mie::MieTable::Bracket& b = brackets_[wl];
+    const double p0 = table_->EvalPhase(b.i0, at);
+    return b.t == 0.0 ? p0 : p0 + (table_->EvalPhase(b.i1, at) - p0) * b.t;
+  }
   std::shared_ptr<const mie::MieTable> table_;
   std::vector<mie::MieTable::Bracket> brackets_;
 };
