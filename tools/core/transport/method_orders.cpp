@@ -50,6 +50,120 @@ void Gather16(const float* const* v, const float* wv, int k0, int k1, size_t nw,
   }
 }
 
+// The modal scatter's three products (SolveMultipleScattering), 8 wavelengths at a time in GCC
+// vectors with the sums kept in registers; every sum in the order of the plain loop it replaces
+// (contraction is off), so the same bytes. V8 as in Gather16.
+using ModalV8 = float __attribute__((vector_size(32)));
+inline ModalV8 LoadV8(const float* p) {
+  ModalV8 x;
+  std::memcpy(&x, p, sizeof x);
+  return x;
+}
+inline void StoreV8(float* p, ModalV8 x) { std::memcpy(p, &x, sizeof x); }
+
+// out[m * out_stride + w] = sum_{q ascending} cos_mq[m * nq + q] l[q * nw + w], m < nm.
+void ModalAnalysis(const float* l, const float* cos_mq, size_t nm, size_t nq, size_t nw, float* out, size_t out_stride) {
+  size_t m = 0;
+  for (; m + 4 <= nm; m += 4) {
+    size_t w = 0;
+    for (; w + 8 <= nw; w += 8) {
+      ModalV8 a0 = {}, a1 = {}, a2 = {}, a3 = {};
+      for (size_t q = 0; q < nq; ++q) {
+        const ModalV8 x = LoadV8(l + q * nw + w);
+        a0 += cos_mq[m * nq + q] * x;
+        a1 += cos_mq[(m + 1) * nq + q] * x;
+        a2 += cos_mq[(m + 2) * nq + q] * x;
+        a3 += cos_mq[(m + 3) * nq + q] * x;
+      }
+      StoreV8(out + m * out_stride + w, a0);
+      StoreV8(out + (m + 1) * out_stride + w, a1);
+      StoreV8(out + (m + 2) * out_stride + w, a2);
+      StoreV8(out + (m + 3) * out_stride + w, a3);
+    }
+    for (; w < nw; ++w) {
+      for (size_t i = 0; i < 4; ++i) {
+        float a = 0.0f;
+        for (size_t q = 0; q < nq; ++q) a += cos_mq[(m + i) * nq + q] * l[q * nw + w];
+        out[(m + i) * out_stride + w] = a;
+      }
+    }
+  }
+  for (; m < nm; ++m) {
+    for (size_t w = 0; w < nw; ++w) {
+      float a = 0.0f;
+      for (size_t q = 0; q < nq; ++q) a += cos_mq[m * nq + q] * l[q * nw + w];
+      out[m * out_stride + w] = a;
+    }
+  }
+}
+
+// acc[b * nw + w] (+)= sum_{j ascending < n} g[j * g_stride + w] x[b * b_stride + j * x_stride + w]
+// for the 4 b of a sun block: each g loaded once for the 4.
+template <bool kAdd>
+void ModalBlock4Impl(const float* g, size_t g_stride, const float* x, size_t x_stride, size_t b_stride, size_t n, size_t nw,
+                     float* acc) {
+  size_t w = 0;
+  for (; w + 8 <= nw; w += 8) {
+    ModalV8 a0 = {}, a1 = {}, a2 = {}, a3 = {};
+    if (kAdd) {
+      a0 = LoadV8(acc + w), a1 = LoadV8(acc + nw + w), a2 = LoadV8(acc + 2 * nw + w), a3 = LoadV8(acc + 3 * nw + w);
+    }
+    for (size_t j = 0; j < n; ++j) {
+      const ModalV8 gv = LoadV8(g + j * g_stride + w);
+      const float* xj = x + j * x_stride + w;
+      a0 += gv * LoadV8(xj);
+      a1 += gv * LoadV8(xj + b_stride);
+      a2 += gv * LoadV8(xj + 2 * b_stride);
+      a3 += gv * LoadV8(xj + 3 * b_stride);
+    }
+    StoreV8(acc + w, a0);
+    StoreV8(acc + nw + w, a1);
+    StoreV8(acc + 2 * nw + w, a2);
+    StoreV8(acc + 3 * nw + w, a3);
+  }
+  for (; w < nw; ++w) {
+    for (size_t b = 0; b < 4; ++b) {
+      float a = kAdd ? acc[b * nw + w] : 0.0f;
+      for (size_t j = 0; j < n; ++j) a += g[j * g_stride + w] * x[b * b_stride + j * x_stride + w];
+      acc[b * nw + w] = a;
+    }
+  }
+}
+void ModalBlock4(const float* g, size_t g_stride, const float* x, size_t x_stride, size_t b_stride, size_t n, size_t nw, float* acc) {
+  ModalBlock4Impl<false>(g, g_stride, x, x_stride, b_stride, n, nw, acc);
+}
+void ModalBlock4Add(const float* g, size_t g_stride, const float* x, size_t x_stride, size_t b_stride, size_t n, size_t nw,
+                    float* acc) {
+  ModalBlock4Impl<true>(g, g_stride, x, x_stride, b_stride, n, nw, acc);
+}
+
+// acc[b * nw + w] = sum_{m ascending < nm} c[m * c_stride] t[b * b_stride + m * nw + w], 4 b.
+void ModalSynthesis4(const float* c, size_t c_stride, const float* t, size_t b_stride, size_t nm, size_t nw, float* acc) {
+  size_t w = 0;
+  for (; w + 8 <= nw; w += 8) {
+    ModalV8 a0 = {}, a1 = {}, a2 = {}, a3 = {};
+    for (size_t m = 0; m < nm; ++m) {
+      const float cm = c[m * c_stride];
+      const float* tm = t + m * nw + w;
+      a0 += cm * LoadV8(tm);
+      a1 += cm * LoadV8(tm + b_stride);
+      a2 += cm * LoadV8(tm + 2 * b_stride);
+      a3 += cm * LoadV8(tm + 3 * b_stride);
+    }
+    StoreV8(acc + w, a0);
+    StoreV8(acc + nw + w, a1);
+    StoreV8(acc + 2 * nw + w, a2);
+    StoreV8(acc + 3 * nw + w, a3);
+  }
+  for (; w < nw; ++w) {
+    for (size_t b = 0; b < 4; ++b) {
+      float a = 0.0f;
+      for (size_t m = 0; m < nm; ++m) a += c[m * c_stride] * t[b * b_stride + m * nw + w];
+      acc[b * nw + w] = a;
+    }
+  }
+}
+
 // ---------------------------------------------------------------------------- settings
 
 struct OrdersSettings {
@@ -1558,75 +1672,70 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
     });
   }
   auto scatter_modal = [&](const std::vector<float>& Lin, std::vector<float>* Jout) {
-    // Tasks (radius, block of 4 sun nodes), as the matrix's: each G element loaded serves 4.
-    constexpr size_t kSunBlock = 4;
+    // The three products run 8 wavelengths wide with their sums kept in registers (ModalBlock4
+    // and the others above), each sum in the order of the plain loops they replace (analysis: q
+    // ascending; modes: k2 ascending; synthesis: m ascending, then the end columns e, k2
+    // ascending), so the bytes are those of the loops that stored and reloaded every partial sum
+    // (until 2026-11-24, sixth stop; docs/sky-methods.md "Cost cuts of 2026-11-24, sixth stop").
+    // Tasks (radius, block of up to 16 sun nodes): G (nm nu^2 nw floats per radius, 9 MB for high)
+    // and D (twice that) do not fit in cache and are read once per task; within a task each
+    // G or D slice (nu nw floats) serves the 4 sub-blocks of 4 sun nodes while in L1. With
+    // tasks of 4 sun nodes high's scatter was bound by reading G and D (27 MB per radius) 11
+    // times per order.
+    constexpr size_t kSub = 4, kSunBlock = 16;
     const size_t nsb = (ns_ + kSunBlock - 1) / kSunBlock;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nr * nsb, 1), [&](const tbb::blocked_range<size_t>& rg) {
-      std::vector<float> S(kSunBlock * nm * nu_ * nw_), T(kSunBlock * nu_ * nm * nw_), dL(kSunBlock * 2 * nu_ * nw_), acc(nw_);
+      // S[b][m][k2][w], T[b][k][m][w], dL[b][e][k2][w]; a short last sub-block computes its
+      // unused b from zeros and stores nothing of them.
+      std::vector<float> S(kSunBlock * nm * nu_ * nw_, 0.0f), T(kSunBlock * nu_ * nm * nw_, 0.0f),
+          dL(kSunBlock * 2 * nu_ * nw_, 0.0f), acc(kSub * nw_);
+      const size_t sb = nm * nu_ * nw_, tb = nu_ * nm * nw_, db = 2 * nu_ * nw_;
       for (size_t idx = rg.begin(); idx != rg.end(); ++idx) {
         const size_t ri = idx / nsb, s0 = (idx % nsb) * kSunBlock, s1 = std::min(ns_, s0 + kSunBlock), nb = s1 - s0;
+        const size_t nsub = (nb + kSub - 1) / kSub;
         const float* G = &modal_kernels[ri * modal_floats];
         // Analysis: S[b][m][k2] = sum_q L(k2, q) cos(m theta_q); the end differences dL.
-        std::fill(S.begin(), S.end(), 0.0f);
         for (size_t b = 0; b < nb; ++b) {
           const float* lin = &Lin[((ri * ns_ + s0 + b) * nd) * nw_];
           for (size_t k2 = 0; k2 < nu_; ++k2) {
-            for (size_t m = 0; m < nm; ++m) {
-              float* sv = &S[((b * nm + m) * nu_ + k2) * nw_];
-              for (size_t q = 0; q < nphi; ++q) {
-                const float cm = cos_mq[m * nphi + q];
-                const float* lv = &lin[(k2 * nphi + q) * nw_];
-                for (size_t w = 0; w < nw_; ++w) sv[w] += cm * lv[w];
-              }
-            }
+            ModalAnalysis(&lin[k2 * nphi * nw_], cos_mq.data(), nm, nphi, nw_, &S[b * sb + k2 * nw_], nu_ * nw_);
             if (has_ends) {
               for (size_t e = 0; e < 2; ++e) {
                 const size_t q0 = e == 0 ? 0 : nphi - 2;
                 const float* l0 = &lin[(k2 * nphi + q0) * nw_];
-                float* dv = &dL[((b * 2 + e) * nu_ + k2) * nw_];
+                float* dv = &dL[b * db + (e * nu_ + k2) * nw_];
                 for (size_t w = 0; w < nw_; ++w) dv[w] = l0[w] - l0[nw_ + w];
               }
             }
           }
         }
         // Modes: T[b][k][m] = sum_k2 G_m(k, k2) S[b][m][k2].
-        std::fill(T.begin(), T.end(), 0.0f);
         for (size_t m = 0; m < nm; ++m) {
           for (size_t k = 0; k < nu_; ++k) {
-            for (size_t k2 = 0; k2 < nu_; ++k2) {
-              const float* g = &G[((m * nu_ + k) * nu_ + k2) * nw_];
-              for (size_t b = 0; b < nb; ++b) {
-                const float* sv = &S[((b * nm + m) * nu_ + k2) * nw_];
-                float* tv = &T[((b * nu_ + k) * nm + m) * nw_];
-                for (size_t w = 0; w < nw_; ++w) tv[w] += g[w] * sv[w];
-              }
+            for (size_t u = 0; u < nsub; ++u) {
+              ModalBlock4(&G[(m * nu_ + k) * nu_ * nw_], nw_, &S[u * kSub * sb + m * nu_ * nw_], nw_, sb, nu_, nw_, acc.data());
+              for (size_t b = 0; b < kSub; ++b) std::copy_n(&acc[b * nw_], nw_, &T[(u * kSub + b) * tb + (k * nm + m) * nw_]);
             }
           }
         }
         // Synthesis, the end columns, and J stored per unit sigma_s* (as the matrix's scatter).
-        for (size_t b = 0; b < nb; ++b) {
-          float* jb = &(*Jout)[((ri * ns_ + s0 + b) * nd) * nw_];
-          for (size_t k = 0; k < nu_; ++k) {
-            for (size_t q = 0; q < nphi; ++q) {
-              std::fill(acc.begin(), acc.end(), 0.0f);
-              for (size_t m = 0; m < nm; ++m) {
-                const float cm = cos_mq[m * nphi + q];
-                const float* tv = &T[((b * nu_ + k) * nm + m) * nw_];
-                for (size_t w = 0; w < nw_; ++w) acc[w] += cm * tv[w];
-              }
+        for (size_t k = 0; k < nu_; ++k) {
+          for (size_t q = 0; q < nphi; ++q) {
+            for (size_t u = 0; u < nsub; ++u) {
+              ModalSynthesis4(&cos_mq[q], nphi, &T[u * kSub * tb + k * nm * nw_], tb, nm, nw_, acc.data());
               if (has_ends) {
                 for (size_t e = 0; e < 2; ++e) {
                   const float* Dv = &end_kernels[ri * end_floats + (((e * nu_ + k) * nphi + q) * nu_) * nw_];
-                  const float* dv = &dL[((b * 2 + e) * nu_) * nw_];
-                  for (size_t k2 = 0; k2 < nu_; ++k2) {
-                    for (size_t w = 0; w < nw_; ++w) acc[w] += Dv[k2 * nw_ + w] * dv[k2 * nw_ + w];
-                  }
+                  ModalBlock4Add(Dv, nw_, &dL[u * kSub * db + e * nu_ * nw_], nw_, db, nu_, nw_, acc.data());
                 }
               }
-              float* jo = &jb[(k * nphi + q) * nw_];
-              for (size_t w = 0; w < nw_; ++w) {
-                const double st = ssc_total[ri * nw_ + w];
-                jo[w] = st > 0.0 ? static_cast<float>(acc[w] / st) : 0.0f;
+              for (size_t b = 0; b < kSub && u * kSub + b < nb; ++b) {
+                float* jo = &(*Jout)[(((ri * ns_ + s0 + u * kSub + b) * nd) + k * nphi + q) * nw_];
+                const float* a = &acc[b * nw_];
+                for (size_t w = 0; w < nw_; ++w) {
+                  const double st = ssc_total[ri * nw_ + w];
+                  jo[w] = st > 0.0 ? static_cast<float>(a[w] / st) : 0.0f;
+                }
               }
             }
           }
