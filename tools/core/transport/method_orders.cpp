@@ -1628,7 +1628,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
     for (size_t m = 0; m < nm; ++m) {
       for (size_t d = 0; d < N; ++d) cosd[m * N + d] = std::cos(static_cast<double>(m * d) * kPi / s_.nphi);
     }
-    std::vector<double> scale(nw_);
+    std::vector<double> scale(nw_), v(nw_);
     for (size_t k = 0; k < nu_; ++k) {
       std::fill(scale.begin(), scale.end(), 0.0);
       for (size_t k2 = 0; k2 < nu_; ++k2) {
@@ -1642,11 +1642,14 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
         const double f = (m == 0 ? 1.0 : 2.0) / s_.nphi;
         for (size_t k2 = 0; k2 < nu_; ++k2) {
           float* g = &G[((m * nu_ + k) * nu_ + k2) * nw_];
-          for (size_t w = 0; w < nw_; ++w) {
-            double v = 0.0;
-            for (size_t d = 0; d < N; ++d) v += c[((k * nu_ + k2) * N + d) * nw_ + w] * cosd[m * N + d];
-            g[w] = static_cast<float>(f * scale[w] * v);
+          // v[w] = sum_d c(d) cos(m d pi / nphi), d ascending, every wavelength at once.
+          std::fill(v.begin(), v.end(), 0.0);
+          for (size_t d = 0; d < N; ++d) {
+            const double* cv = &c[((k * nu_ + k2) * N + d) * nw_];
+            const double cm = cosd[m * N + d];
+            for (size_t w = 0; w < nw_; ++w) v[w] += cv[w] * cm;
           }
+          for (size_t w = 0; w < nw_; ++w) g[w] = static_cast<float>(f * scale[w] * v[w]);
         }
       }
       if (D != nullptr) {
