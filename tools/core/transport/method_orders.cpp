@@ -1303,11 +1303,18 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
   };
   ReportProgress(progress, "orders: order 1", 0.0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nr * ns_ * nu_, 4), [&](const tbb::blocked_range<size_t>& rg) {
-    std::vector<float> tsun(nw_), ssc(nw_), src(nw_), acc(nw_), pc(nc_ * nw_), eg(nw_);
+    std::vector<float> tsun(nw_), src(nw_), acc(nw_), pc(nc_ * nw_), eg(nw_), ssc;
     for (size_t idx = rg.begin(); idx != rg.end(); ++idx) {
       const size_t ri = idx / (ns_ * nu_), si = (idx / nu_) % ns_, k = idx % nu_;
       const Family& f = fam[ri * nu_ + k];
       const double r = radius_[ri], ts = sun_theta_rad_[si];
+      // sigma_s* of every component at the family's steps, the same for all its azimuths (it was
+      // located and interpolated once per azimuth node: 36 times over for high).
+      ssc.resize(f.t.size() * nc_ * nw_);
+      for (size_t m = 0; m < f.t.size(); ++m) {
+        const AtmosphereModel::Cell cm = m_.Locate(f.r[m] - R);
+        for (size_t c = 0; c < nc_; ++c) SigmaS(c, cm, true, &ssc[(m * nc_ + c) * nw_]);
+      }
       for (size_t q = 0; q < nphi; ++q) {
         double mu, nu;
         cell_geometry(ri, si, k, q, &mu, &nu);
@@ -1320,8 +1327,8 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
           SunTransmittance(f.r[m], mus, true, tsun.data());
           std::fill(src.begin(), src.end(), 0.0f);
           for (size_t c = 0; c < nc_; ++c) {
-            SigmaS(c, f.r[m] - R, true, ssc.data());
-            for (size_t w = 0; w < nw_; ++w) src[w] += ssc[w] * pc[c * nw_ + w];
+            const float* sv = &ssc[(m * nc_ + c) * nw_];
+            for (size_t w = 0; w < nw_; ++w) src[w] += sv[w] * pc[c * nw_ + w];
           }
           for (size_t w = 0; w < nw_; ++w) acc[w] += f.wt[m * nw_ + w] * src[w] * tsun[w] * static_cast<float>(sun_e_[w]);
           if (!sun_az.empty()) sun_az[Cell(ri, si, k, q) * nt + m] = step_sun_azimuth(f, m, r, ts, nu);
