@@ -164,6 +164,41 @@ void ModalSynthesis4(const float* c, size_t c_stride, const float* t, size_t b_s
   }
 }
 
+// The solve's tables (a field over every cell and wavelength: 178 MB for high) in vectors whose
+// elements start uninitialised, zeroed in parallel by ZeroTable: a std::vector<float> of that
+// size is zeroed on one thread, and the kernel's zeroing of the fresh pages on first touch with
+// it (~1.8 GB for high, ~2.5 s of system time: most of high's shortfall from 2x at 2 threads).
+// The same values, the same bytes. 2026-11-24, sixth stop.
+template <class T>
+struct UninitAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = UninitAllocator<U>;
+  };
+  UninitAllocator() = default;
+  template <class U>
+  UninitAllocator(const UninitAllocator<U>&) noexcept {}
+  template <class U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... A>
+  void construct(U* p, A&&... a) {
+    ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
+  }
+};
+using Table = std::vector<float, UninitAllocator<float>>;
+
+// v = n zeros, written in parallel blocks (the first touch of fresh pages spread over the threads).
+void ZeroTable(Table* v, size_t n) {
+  Table().swap(*v);
+  v->resize(n);
+  constexpr size_t kBlock = size_t{1} << 18;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, (n + kBlock - 1) / kBlock, 1), [&](const tbb::blocked_range<size_t>& rg) {
+    for (size_t b = rg.begin(); b != rg.end(); ++b) std::fill(v->begin() + b * kBlock, v->begin() + std::min(n, (b + 1) * kBlock), 0.0f);
+  });
+}
+
 // ---------------------------------------------------------------------------- settings
 
 struct OrdersSettings {
@@ -537,7 +572,7 @@ class OrdersMethod : public SkyMethod {
   static constexpr uint16_t kNoSun = 0xFFFF;
   SunAzimuth SunAzimuthAt(double theta_s, double cos_phi) const;
   // Interpolates table `tab` (cells x nw) at a point, accumulating weight * value into acc.
-  void Interpolate(const std::vector<float>& tab, const RadialView& rv, const SunAzimuth& sa, double weight,
+  void Interpolate(const Table& tab, const RadialView& rv, const SunAzimuth& sa, double weight,
                    float* acc) const;
 
   const AtmosphereModel& m_;
@@ -580,7 +615,7 @@ class OrdersMethod : public SkyMethod {
   std::vector<float> ms_;  // accumulated orders >= 2 at the observer radius: [(si*nu+k)*nphi+q]*nw
   // Accumulated multiple-scattering source J_ms* = sum_{n>=2} J_n at every node (cells x nw),
   // for view segments: L_seg,ms = int_0^t_end T* J_ms* dt.
-  std::vector<float> jms_;
+  Table jms_;
   int orders_done_ = 0;
   bool tail_ = false;
   double last_fraction_ = 0.0;
@@ -1056,7 +1091,7 @@ OrdersMethod::SunAzimuth OrdersMethod::SunAzimuthAt(double theta_s, double cos_p
   return sa;
 }
 
-void OrdersMethod::Interpolate(const std::vector<float>& tab, const RadialView& rv, const SunAzimuth& sa, double weight,
+void OrdersMethod::Interpolate(const Table& tab, const RadialView& rv, const SunAzimuth& sa, double weight,
                                float* acc) const {
   if (sa.si == kNoSun) return;  // beyond the last sun node: no light
   const Lerp ls{sa.si, sa.ts};
@@ -1247,7 +1282,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
 
   // Irradiance at the ground from a table of radiance (upper view nodes at radius node 0):
   // E[si*nw + w] = sum over up nodes and both azimuth halves of L mu dOmega.
-  auto ground_irradiance = [&](const std::vector<float>& L, std::vector<float>* E) {
+  auto ground_irradiance = [&](const Table& L, std::vector<float>* E) {
     E->assign(ns_ * nw_, 0.0f);
     for (size_t si = 0; si < ns_; ++si) {
       for (size_t k = static_cast<size_t>(s_.ndn); k < nu_; ++k) {
@@ -1273,7 +1308,8 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
 
   // --- order 1 (scaled problem) at every node
   // L = L_{n-1} while order n is computed into Lnext; Lprev = L_{n-2} (for the ratio tests).
-  std::vector<float> L(cells * nw_, 0.0f), J(cells * nw_, 0.0f), Lnext(cells * nw_, 0.0f), Lprev(cells * nw_, 0.0f);
+  Table L, J, Lnext, Lprev;
+  for (Table* t : {&L, &J, &Lnext, &Lprev}) ZeroTable(t, cells * nw_);
   std::vector<float> E0(ns_ * nw_);  // direct sun at the ground (scaled transmittance)
   {
     std::vector<float> tr(nw_);
@@ -1345,7 +1381,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
 
   // --- orders 2, 3, ...
   ms_.assign(ns_ * nu_ * nphi * nw_, 0.0f);
-  jms_.assign(cells * nw_, 0.0f);
+  ZeroTable(&jms_, cells * nw_);
   const size_t nd = nu_ * nphi;  // directions per (radius, sun)
   std::vector<float> E(ns_ * nw_);
   double prev_norm = 0.0, prev_ratio = -1.0, prev_prev_ratio = -1.0;
@@ -1671,17 +1707,17 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
       }
     }
   };
-  std::vector<float> modal_kernels, end_kernels;
+  Table modal_kernels, end_kernels;
   if (modal) {
-    modal_kernels.resize(nr * modal_floats);
-    end_kernels.resize(nr * end_floats);
+    ZeroTable(&modal_kernels, nr * modal_floats);
+    ZeroTable(&end_kernels, nr * end_floats);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nr, 1), [&](const tbb::blocked_range<size_t>& rg) {
       for (size_t ri = rg.begin(); ri != rg.end(); ++ri) {
         build_modal_kernel(ri, &modal_kernels[ri * modal_floats], has_ends ? &end_kernels[ri * end_floats] : nullptr);
       }
     });
   }
-  auto scatter_modal = [&](const std::vector<float>& Lin, std::vector<float>* Jout) {
+  auto scatter_modal = [&](const Table& Lin, Table* Jout) {
     // The three products run 8 wavelengths wide with their sums kept in registers (ModalBlock4
     // and the others above), each sum in the order of the plain loops they replace (analysis: q
     // ascending; modes: k2 ascending; synthesis: m ascending, then the end columns e, k2
@@ -1760,7 +1796,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
       for (size_t ri = rg.begin(); ri != rg.end(); ++ri) build_kernel(ri, &kernels[ri * kernel_floats]);
     });
   }
-  auto scatter = [&](const std::vector<float>& Lin, std::vector<float>* Jout) {
+  auto scatter = [&](const Table& Lin, Table* Jout) {
     // J_n = sum_c sigma_s*_c P*_c applied to L_{n-1}, per radius: a (nd x nd) kernel per
     // wavelength. Tasks are (radius, block of 4 sun nodes): each kernel element loaded is used
     // for 4 sun nodes (the product is load-bound otherwise).
@@ -1833,7 +1869,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
     }
   }
   std::vector<float> cfac;  // [((ri * ns + si) * (kLogBins + 1) + b) * nw + w], si >= loglin_first
-  auto build_cfac = [&](const std::vector<float>& Jin) {
+  auto build_cfac = [&](const Table& Jin) {
     if (loglin_first >= ns_) return;
     cfac.assign(nr * ns_ * (kLogBins + 1) * nw_, 1.0f);
     tbb::parallel_for(size_t{0}, nr, [&](size_t ri) {
@@ -1872,7 +1908,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
       jlo[w] = jlo[w] * f0 + jhi[w] * f1;
     }
   };
-  auto transport_cells = [&](const std::vector<float>& Jin, const std::vector<float>& Lin, std::vector<float>* Lout) {
+  auto transport_cells = [&](const Table& Jin, const Table& Lin, Table* Lout) {
     ground_irradiance(Lin, &E);
     build_cfac(Jin);
     // L_n = int T* J_n dt + ground reflection of E_{n-1}.
@@ -1941,7 +1977,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
   // products per wavelength per cell instead of 16, and the cells' reads go to the slab instead of
   // 16 scattered table rows. The same sums in another order: the result differs from the
   // cell-by-cell form by float rounding (MethodOrders.SplitGatherIsTheCellGather).
-  auto transport_split = [&](const std::vector<float>& Jin, const std::vector<float>& Lin, std::vector<float>* Lout) {
+  auto transport_split = [&](const Table& Jin, const Table& Lin, Table* Lout) {
     ground_irradiance(Lin, &E);
     build_cfac(Jin);
     const size_t plane = ns_ * nphi;  // cells of one family
@@ -2032,7 +2068,7 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
       }
     });
   };
-  auto transport = [&](const std::vector<float>& Jin, const std::vector<float>& Lin, std::vector<float>* Lout) {
+  auto transport = [&](const Table& Jin, const Table& Lin, Table* Lout) {
     if (s_.gather_split) transport_split(Jin, Lin, Lout);
     else transport_cells(Jin, Lin, Lout);
   };
@@ -2040,7 +2076,9 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
     ReportProgress(progress, fmt::format("orders: order {}", order), 0.0);
     if (modal) scatter_modal(L, &J);
     else scatter(L, &J);
-    for (size_t i = 0; i < jms_.size(); ++i) jms_[i] += J[i];
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, jms_.size(), size_t{1} << 18), [&](const tbb::blocked_range<size_t>& rg) {
+      for (size_t i = rg.begin(); i != rg.end(); ++i) jms_[i] += J[i];
+    });
     transport(J, L, &Lnext);
     // Rotate: L = L_n, Lprev = L_{n-1}, Lnext = L_{n-2}.
     std::swap(Lprev, L);
@@ -2101,7 +2139,9 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
           for (size_t w = 0; w < nw_; ++w) a[w] += tail_at(e0 + w) * L[e0 + w];
         }
       }
-      for (size_t i = 0; i < jms_.size(); ++i) jms_[i] += tail_at(i) * J[i];
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, jms_.size(), size_t{1} << 18), [&](const tbb::blocked_range<size_t>& rg) {
+        for (size_t i = rg.begin(); i != rg.end(); ++i) jms_[i] += tail_at(i) * J[i];
+      });
       tail_ = true;
       break;
     }
