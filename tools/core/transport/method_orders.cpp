@@ -97,9 +97,10 @@ void ModalAnalysis(const float* l, const float* cos_mq, size_t nm, size_t nq, si
   }
 }
 
-// acc[b * nw + w] (+)= sum_{j ascending < n} g[j * g_stride + w] x[b * b_stride + j * x_stride + w]
-// for the 4 b of a sun block: each g loaded once for the 4.
-template <bool kAdd>
+// acc[b * nw + w] (+)= sum_{j ascending < n} g_j x[b * b_stride + j * x_stride + w] for the 4 b of a
+// sun block, g_j = g[j * g_stride + w] (kScalar false: a row per j, loaded once for the 4 b) or
+// g[j * g_stride] (kScalar true: one weight per j).
+template <bool kAdd, bool kScalar>
 void ModalBlock4Impl(const float* g, size_t g_stride, const float* x, size_t x_stride, size_t b_stride, size_t n, size_t nw,
                      float* acc) {
   size_t w = 0;
@@ -109,7 +110,12 @@ void ModalBlock4Impl(const float* g, size_t g_stride, const float* x, size_t x_s
       a0 = LoadV8(acc + w), a1 = LoadV8(acc + nw + w), a2 = LoadV8(acc + 2 * nw + w), a3 = LoadV8(acc + 3 * nw + w);
     }
     for (size_t j = 0; j < n; ++j) {
-      const ModalV8 gv = LoadV8(g + j * g_stride + w);
+      ModalV8 gv;
+      if (kScalar) {
+        gv = ModalV8{} + g[j * g_stride];  // the weight in every lane
+      } else {
+        gv = LoadV8(g + j * g_stride + w);
+      }
       const float* xj = x + j * x_stride + w;
       a0 += gv * LoadV8(xj);
       a1 += gv * LoadV8(xj + b_stride);
@@ -124,44 +130,21 @@ void ModalBlock4Impl(const float* g, size_t g_stride, const float* x, size_t x_s
   for (; w < nw; ++w) {
     for (size_t b = 0; b < 4; ++b) {
       float a = kAdd ? acc[b * nw + w] : 0.0f;
-      for (size_t j = 0; j < n; ++j) a += g[j * g_stride + w] * x[b * b_stride + j * x_stride + w];
+      for (size_t j = 0; j < n; ++j) a += g[j * g_stride + (kScalar ? 0 : w)] * x[b * b_stride + j * x_stride + w];
       acc[b * nw + w] = a;
     }
   }
 }
 void ModalBlock4(const float* g, size_t g_stride, const float* x, size_t x_stride, size_t b_stride, size_t n, size_t nw, float* acc) {
-  ModalBlock4Impl<false>(g, g_stride, x, x_stride, b_stride, n, nw, acc);
+  ModalBlock4Impl<false, false>(g, g_stride, x, x_stride, b_stride, n, nw, acc);
 }
 void ModalBlock4Add(const float* g, size_t g_stride, const float* x, size_t x_stride, size_t b_stride, size_t n, size_t nw,
                     float* acc) {
-  ModalBlock4Impl<true>(g, g_stride, x, x_stride, b_stride, n, nw, acc);
+  ModalBlock4Impl<true, false>(g, g_stride, x, x_stride, b_stride, n, nw, acc);
 }
-
 // acc[b * nw + w] = sum_{m ascending < nm} c[m * c_stride] t[b * b_stride + m * nw + w], 4 b.
 void ModalSynthesis4(const float* c, size_t c_stride, const float* t, size_t b_stride, size_t nm, size_t nw, float* acc) {
-  size_t w = 0;
-  for (; w + 8 <= nw; w += 8) {
-    ModalV8 a0 = {}, a1 = {}, a2 = {}, a3 = {};
-    for (size_t m = 0; m < nm; ++m) {
-      const float cm = c[m * c_stride];
-      const float* tm = t + m * nw + w;
-      a0 += cm * LoadV8(tm);
-      a1 += cm * LoadV8(tm + b_stride);
-      a2 += cm * LoadV8(tm + 2 * b_stride);
-      a3 += cm * LoadV8(tm + 3 * b_stride);
-    }
-    StoreV8(acc + w, a0);
-    StoreV8(acc + nw + w, a1);
-    StoreV8(acc + 2 * nw + w, a2);
-    StoreV8(acc + 3 * nw + w, a3);
-  }
-  for (; w < nw; ++w) {
-    for (size_t b = 0; b < 4; ++b) {
-      float a = 0.0f;
-      for (size_t m = 0; m < nm; ++m) a += c[m * c_stride] * t[b * b_stride + m * nw + w];
-      acc[b * nw + w] = a;
-    }
-  }
+  ModalBlock4Impl<false, true>(c, c_stride, t, nw, b_stride, nm, nw, acc);
 }
 
 // The solve's tables (a field over every cell and wavelength: 178 MB for high) in vectors whose
