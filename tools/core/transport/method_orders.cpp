@@ -1715,7 +1715,8 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
     const size_t nsb = (ns_ + kSunBlock - 1) / kSunBlock;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nr * nsb, 1), [&](const tbb::blocked_range<size_t>& rg) {
       // S[b][m][k2][w], T[b][k][m][w], dL[b][e][k2][w]; a short last sub-block computes its
-      // unused b from zeros and stores nothing of them.
+      // unused b from what the buffers hold (zeros or an earlier block's finite values) and
+      // stores nothing of them.
       std::vector<float> S(kSunBlock * nm * nu_ * nw_, 0.0f), T(kSunBlock * nu_ * nm * nw_, 0.0f),
           dL(kSunBlock * 2 * nu_ * nw_, 0.0f), acc(kSub * nw_);
       const size_t sb = nm * nu_ * nw_, tb = nu_ * nm * nw_, db = 2 * nu_ * nw_;
