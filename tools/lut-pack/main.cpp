@@ -9,10 +9,16 @@
 //   lut-pack check LUT.ktx2[:WEIGHT] ... --direct DIRECT.exr -o check.json [--sun-cone-deg 5]
 //       decodes the LUT (or the weighted blend of several) at the direct render's sun angles and
 //       directions and reports the luminance error.
+//   lut-pack decode LUT.ktx2[:WEIGHT] ... --sun-zenith-deg 30,70 --size 64x32 -o dome.exr
+//       the decoded sky (or blend) on upper-hemisphere domes (lut/dome_view.h), one per sun angle,
+//       stacked vertically: the reference the runtime shader is checked against (docs/runtime.md).
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <numbers>
 #include <set>
 
 #include <fmt/format.h>
@@ -24,6 +30,7 @@
 #include "io/yaml.h"
 #include "lut/check.h"
 #include "lut/decoder.h"
+#include "lut/dome_view.h"
 #include "lut/ktx2.h"
 #include "lut/sky_lut.h"
 #include "outputs.h"
@@ -86,7 +93,84 @@ int main(int argc, char** argv) {
   check->add_option("--time-interpolation", interp, "Blend of neighbouring slices: geometric (default) or linear (the talk's lerp)")
       ->check(CLI::IsMember({"geometric", "linear"}));
 
+  CLI::App* decode = cli.app().add_subcommand("decode", "Decode LUTs (or a weighted blend) on upper-hemisphere domes");
+  std::vector<std::string> decode_luts;
+  std::vector<double> decode_sza;
+  std::string decode_out, decode_size = "64x32";
+  decode->add_option("luts", decode_luts, "LUT.ktx2 or LUT.ktx2:WEIGHT (several: the weighted blend sum_k w_k L_k)")->required();
+  decode->add_option("--sun-zenith-deg", decode_sza, "Sun zenith angles (deg, 0-180), comma separated")
+      ->delimiter(',')->required();
+  decode->add_option("--size", decode_size, "Dome size WxH (azimuth x zenith angle 0-90 deg)")->default_val("64x32");
+  decode->add_option("-o,--output", decode_out, "The domes (EXR: R, G, B Linear Rec.2020 cd/m^2, one W x H dome per sun angle, stacked)")
+      ->required();
+  decode->add_option("--time-interpolation", interp, "Blend of neighbouring slices: geometric (default) or linear (the talk's lerp)")
+      ->check(CLI::IsMember({"geometric", "linear"}));
+
+  // LUT.ktx2[:WEIGHT] -> path and weight (UsageError otherwise).
+  auto split_weighted = [](const std::string& l) {
+    std::string path = l;
+    double w = 1.0;
+    const size_t colon = l.rfind(':');
+    if (colon != std::string::npos && colon > 0) {
+      try {
+        size_t used = 0;
+        w = std::stod(l.substr(colon + 1), &used);
+        if (used != l.size() - colon - 1) throw std::invalid_argument("trailing");
+        path = l.substr(0, colon);
+      } catch (const std::exception&) {
+        throw UsageError("expected LUT.ktx2 or LUT.ktx2:WEIGHT, got '" + l + "'");
+      }
+      if (!std::isfinite(w)) throw UsageError("the weight of '" + l + "' must be a finite number");
+    }
+    return std::pair<std::string, double>{path, w};
+  };
+
   return cli.Run(argc, argv, [&] {
+    if (decode->parsed()) {
+      int w = 0, h = 0;
+      char tail = 0;
+      if (std::sscanf(decode_size.c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192) {
+        throw UsageError("--size: expected WxH with 1 <= W, H <= 8192, got '" + decode_size + "'");
+      }
+      for (double z : decode_sza) {
+        if (!(z >= 0.0 && z <= 180.0)) throw UsageError(fmt::format("--sun-zenith-deg: {} is not in 0-180", z));
+      }
+      std::vector<lut::SkyLutDecoder> decoders;
+      std::vector<double> weights;
+      decoders.reserve(decode_luts.size());
+      for (const std::string& l : decode_luts) {
+        const auto [path, weight] = split_weighted(l);
+        decoders.push_back(lut::SkyLutDecoder::FromKtx2(ktx2::ReadKtx2(path), path));
+        decoders.back().set_time_interpolation(interp == "linear" ? lut::TimeInterpolation::kLinear : lut::TimeInterpolation::kGeometric);
+        weights.push_back(weight);
+      }
+      std::vector<std::pair<const lut::SkyLutDecoder*, double>> weighted;
+      for (size_t i = 0; i < decoders.size(); ++i) weighted.emplace_back(&decoders[i], weights[i]);
+      ExrImage img;
+      img.Resize(w, h * static_cast<int>(decode_sza.size()), {"R", "G", "B"});
+      for (size_t k = 0; k < decode_sza.size(); ++k) {
+        const std::vector<float> dome = lut::DecodeDome(weighted, decode_sza[k] * std::numbers::pi / 180.0, w, h);
+        std::copy(dome.begin(), dome.end(), img.pixels.begin() + static_cast<long>(k * dome.size()));
+      }
+      std::string list, desc;
+      for (double z : decode_sza) list += (list.empty() ? "" : " ") + FormatExact(z);
+      for (const std::string& l : decode_luts) desc += (desc.empty() ? "" : " + ") + l;
+      img.strings["skybake.quantity"] = "decoded sky radiance (lut/decoder.h, " + interp + " time interpolation) of " + desc;
+      img.strings["skybake.unit"] = "cd/m^2, Linear Rec.2020";
+      img.strings["skybake.mapping"] =
+          "dome (lut/dome_view.h): W x H per sun angle, stacked vertically in the order of skybake.sun_zenith_deg; azimuth "
+          "from the sun 2 pi (x + 1/2)/W - pi, view zenith (pi/2)(y + 1/2)/H";
+      img.strings["skybake.sun_zenith_deg"] = list;
+      Provenance prov;
+      prov.tool = cli.name();
+      prov.parameters = fmt::format("subcommand: decode\nluts: {}\nsun_zenith_deg: [{}]\nsize: {}\ntime_interpolation: {}\n", desc, list,
+                                    decode_size, interp);
+      for (const std::string& l : decode_luts) prov.AddInput(split_weighted(l).first);
+      SetProvenance(img, prov);
+      WriteExr(decode_out, img);
+      cli.Info(fmt::format("{} dome{} of {}x{} for {}", decode_sza.size(), decode_sza.size() == 1 ? "" : "s", w, h, desc));
+      return;
+    }
     if (pack->parsed()) {
       // Parse and validate the inputs.
       std::vector<std::pair<std::string, fs::path>> named;
@@ -155,6 +239,7 @@ int main(int argc, char** argv) {
         for (size_t i = named.size(); i < files_read.size(); ++i) sp.AddInput(files_read[i]);  // OCIO config, CMFs
       }
       std::map<std::string, std::string> files = luttool::EncodeLutSet(set, prov, sky_prov);
+      files["display.json"] = luttool::DisplayShaderJson(config);
       luttool::ReportContext ctx;
       for (const auto& [name, bytes] : files) ctx.file_bytes[name] = bytes.size();
       ctx.budget_bytes = budget_bytes;
@@ -175,19 +260,7 @@ int main(int argc, char** argv) {
     std::vector<double> weights;
     decoders.reserve(luts.size());
     for (const std::string& l : luts) {
-      std::string path = l;
-      double w = 1.0;
-      const size_t colon = l.rfind(':');
-      if (colon != std::string::npos && colon > 0) {
-        try {
-          size_t used = 0;
-          w = std::stod(l.substr(colon + 1), &used);
-          if (used != l.size() - colon - 1) throw std::invalid_argument("trailing");
-          path = l.substr(0, colon);
-        } catch (const std::exception&) {
-          throw UsageError("expected LUT.ktx2 or LUT.ktx2:WEIGHT, got '" + l + "'");
-        }
-      }
+      const auto [path, w] = split_weighted(l);
       decoders.push_back(lut::SkyLutDecoder::FromKtx2(ktx2::ReadKtx2(path), path));
       weights.push_back(w);
     }

@@ -1,5 +1,7 @@
 #include "outputs.h"
 
+#include <nlohmann/json.hpp>
+
 #include <fmt/format.h>
 
 #include "color/color.h"
@@ -51,6 +53,32 @@ dds::Texture Dds(const lut::PackedTexture& t, bool volume) {
 }
 
 }  // namespace
+
+std::string DisplayShaderJson(const ColorConfig& config) {
+  constexpr const char* kFunction = "OCIODisplay";
+  DisplayView view;  // the sRGB display, Un-tone-mapped view (the PNG previews' default)
+  nlohmann::ordered_json j;
+  j["source"] = "lut-pack: OCIO's GPU shader (GpuShaderDesc, GLSL ES 3.0) of the config's display view; docs/runtime.md";
+  j["ocio_config"] = config.path().filename().string();
+  j["ocio_config_cache_id"] = config.cache_id();
+  j["input_colorspace"] = ocio_names::kLinearRec2020;
+  j["display"] = view.display;
+  j["view"] = view.view;
+  j["function"] = kFunction;
+  j["usage"] = "display = OCIODisplay(vec4(radiance_cd_m2 * exposure, 1)).rgb, exposure = 1 / (the luminance in cd/m^2 shown as "
+               "white); the view is not tone-mapped (display-linear 1 = white)";
+  j["glsl"] = config.DisplayShaderGlslEs3(ocio_names::kLinearRec2020, view, kFunction);
+  // Y of Linear Rec.2020 primaries through OCIO (the conversion the packer's statistics use).
+  const ColorProcessor to_xyz = config.Converter(ocio_names::kLinearRec2020, ocio_names::kCieXyzD65);
+  nlohmann::ordered_json y = nlohmann::ordered_json::array();
+  for (int c = 0; c < 3; ++c) {
+    std::array<float, 3> e{0.f, 0.f, 0.f};
+    e[c] = 1.f;
+    y.push_back(to_xyz.Apply(e)[1]);
+  }
+  j["luminance_from_rgb"] = y;
+  return j.dump(2) + "\n";
+}
 
 std::map<std::string, std::string> EncodeLutSet(const lut::LutSet& set, const Provenance& prov,
                                                 const std::map<std::string, Provenance>& sky_prov) {

@@ -11,6 +11,7 @@
 #include <map>
 #include <string>
 
+#include "color/color.h"
 #include "io/exr.h"
 #include "lut/sky_lut.h"
 
@@ -19,6 +20,12 @@ namespace skybake::luttool {
 // File name (in the output folder) -> bytes. A basis sky's own files carry `sky_provenance[name]`
 // (its render alone among the inputs, so that an edit to another sky leaves them byte-identical);
 // the set's files carry `provenance`.
+// display.json: the OCIO config's sRGB display view of Linear Rec.2020 (the textures' space) as
+// GLSL ES 3.00 from OCIO's GPU shader description, and the luminance row Y = k . rgb from OCIO's
+// Linear Rec.2020 -> CIE-XYZ-D65 conversion, for a runtime that shows the textures as the PNG
+// previews do (viewer/, docs/runtime.md).
+std::string DisplayShaderJson(const ColorConfig& config);
+
 std::map<std::string, std::string> EncodeLutSet(const lut::LutSet& set, const Provenance& provenance,
                                                 const std::map<std::string, Provenance>& sky_provenance);
 

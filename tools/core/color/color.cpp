@@ -229,6 +229,34 @@ ColorProcessor ColorConfig::Display(std::string_view src, const DisplayView& vie
   return out;
 }
 
+std::string ColorConfig::DisplayShaderGlslEs3(std::string_view src, const DisplayView& view, const std::string& function_name) const {
+  (void)Display(src, view);  // the same checks of the names and the exposure
+  std::lock_guard<std::recursive_mutex> lock(impl_->mutex);
+  const std::string s(src);
+  const FileLoc where{impl_->path.string(), 0};
+  try {
+    OCIO::DisplayViewTransformRcPtr dv = OCIO::DisplayViewTransform::Create();
+    dv->setSrc(s.c_str());
+    dv->setDisplay(view.display.c_str());
+    dv->setView(view.view.c_str());
+    OCIO::ConstProcessorRcPtr p = impl_->config->getProcessor(dv);
+    OCIO::GpuShaderDescRcPtr desc = OCIO::GpuShaderDesc::CreateShaderDesc();
+    desc->setLanguage(OCIO::GPU_LANGUAGE_GLSL_ES_3_0);
+    desc->setFunctionName(function_name.c_str());
+    desc->setResourcePrefix("ocio_");
+    p->getDefaultGPUProcessor()->extractGpuShaderInfo(desc);
+    if (desc->getNumUniforms() != 0 || desc->getNumTextures() != 0 || desc->getNum3DTextures() != 0) {
+      throw InputError(where, fmt::format("OCIO: the GPU shader of {} -> {}/{} needs {} uniforms, {} 1D/2D and {} 3D textures; "
+                                          "only views without resources are exported",
+                                          s, view.display, view.view, desc->getNumUniforms(), desc->getNumTextures(),
+                                          desc->getNum3DTextures()));
+    }
+    return desc->getShaderText();
+  } catch (const OCIO::Exception& e) {
+    throw InputError(where, fmt::format("OCIO: GPU shader of {} -> {}/{}: {}", s, view.display, view.view, e.what()));
+  }
+}
+
 // ------------------------------------------------------------------------------- previews
 
 std::vector<uint8_t> QuantizeDisplay8(std::span<const float> v) {

@@ -121,6 +121,12 @@ class ColorConfig {
   // processor (a uniform scale, not a colour conversion): OCIO 2.1.2's matrix composition loses
   // scales below ~1e-7, which absolute skies need (color.cpp).
   ColorProcessor Display(std::string_view src, const DisplayView& view) const;
+  // The same display view (without the exposure scale) as OCIO's GPU shader: GLSL ES 3.00 text
+  // of `vec4 function_name(in vec4 inPixel)` from OCIO's GpuShaderDesc, so that a shader
+  // displays the textures exactly as the PNG previews do (viewer/, docs/runtime.md). A view
+  // that needs uniforms or LUT textures is an InputError (skybake's config has none: its views
+  // are matrices and analytic curves).
+  std::string DisplayShaderGlslEs3(std::string_view src, const DisplayView& view, const std::string& function_name) const;
 
  private:
   ColorConfig() = default;  // only through Load: a ColorConfig always holds a valid config
