@@ -9,11 +9,13 @@
 //   domes: [{name, haziness, cloudiness, sun_zenith_deg: [...], width, height}]
 //                                 dome views (lut/dome_view.h) of the weather blend, linear radiance
 //   weights: [[h, c], ...]        the page's basis-sky weights for these (haziness, cloudiness)
+//   display: [{name, haziness, cloudiness, sun_zenith_deg, width, height, white_cd_m2}]
+//                                 one dome through the display pass (OCIO's GLSL): 8-bit codes
 //   fog: [{sky, points: [{sun_zenith_deg, view_zenith_deg, relative_azimuth_deg, depth_m, occlusion}]}]
 //   screenshots: [{name, state}]  the game view with these state overrides -> DIR/<name>.png, and
 //                                 the HDR target's statistics (non-finite texels, max luminance)
 //   fetches: [{name, state}]      mean texture fetches per pixel (sky half / ground half of a level view)
-//   frame_times: [{name, state, frames}]  mean frame time (ms), each frame finished with gl.finish
+//   frame_times: [{name, state, frames}]  mean frame time (ms), each frame waited for (readPixels)
 import fs from 'node:fs';
 import path from 'node:path';
 import {withPage} from './browser.mjs';
@@ -50,6 +52,14 @@ const result = await withPage(page_url, async (page, log) => {
       return {name: d.name, weights: w, views: res.views, fetches_per_pixel: res.fetchesPerPixel};
     }, d);
     r.domes.push(v);
+  }
+  r.display = [];
+  for (const d of plan.display || []) {
+    r.display.push(await page.evaluate((d) => ({
+      name: d.name,
+      codes: window.skybake.domeDisplay(window.skybake.weatherWeights(d.haziness, d.cloudiness), d.sun_zenith_deg, d.width,
+                                        d.height, d.white_cd_m2),
+    }), d));
   }
   r.plan_weights = plan.weights || [];
   r.weights = await page.evaluate((ws) => ws.map(([h, c]) => window.skybake.weatherWeights(h, c)), r.plan_weights);

@@ -112,6 +112,10 @@ def weather_weights(h, c, cloudy):
     return {k: v for k, v in w.items() if v > 0}
 
 
+# The display check: (name, haziness, cloudiness, sun elevation (deg), white (cd/m^2)); whites that
+# clip part of the sky and leave the rest in the curve's steep and flat parts.
+DISPLAY_VIEWS = [("noon", 0.0, 0.0, 60, 6000.0), ("dusk", 0.5, 0.0, 0, 600.0), ("twilight", 0.0, 0.75, -4, 8.0)]
+
 # The dome views: (name, haziness, cloudiness).
 VIEWS = [("clear", 0.0, 0.0), ("hazed", 1.0, 0.0), ("haziness_0.5", 0.5, 0.0), ("cloudiness_0.75", 0.3, 0.75)]
 
@@ -211,6 +215,17 @@ class ViewerTest(TempDirTestCase):
             r = run([tool("lut-pack"), "decode"] + args + ["--sun-zenith-deg", sza, "--size", "%dx%d" % DOME, "-o", exr])
             assert r.returncode == 0, r.stderr
             cls.reference[name] = dump_exr(exr)
+        # The display check: one dome through OCIO's CPU path (lut-pack decode --preview).
+        cls.display_png = {}
+        for name, h, cl, e, white in DISPLAY_VIEWS:
+            weights = weather_weights(h, cl, cls.cloudy)
+            args = ["%s:%r" % (os.path.join(cls.luts, "sky_%s.ktx2" % k), w) for k, w in weights.items()]
+            png = c.path("display_%s.png" % name)
+            r = run([tool("lut-pack"), "decode"] + args + ["--sun-zenith-deg", str(90 - e), "--size", "%dx%d" % DOME,
+                                                          "-o", c.path("display_%s.exr" % name), "--preview", png,
+                                                          "--white-cd-m2", repr(white)])
+            assert r.returncode == 0, r.stderr
+            cls.display_png[name] = png_pixels(png)
         cls.fog_points = []
         for sza_deg in (0, 30, 60, 75.5, 84, 89, 91, 96):
             for vza in (0, 30, 60, 80, 88, 89.5, 95):
@@ -237,6 +252,8 @@ class ViewerTest(TempDirTestCase):
         plan = {
             "domes": [{"name": n, "haziness": h, "cloudiness": cl, "sun_zenith_deg": [90 - e for e in SUN_ELEVATIONS_DEG],
                        "width": DOME[0], "height": DOME[1]} for n, h, cl in VIEWS],
+            "display": [{"name": n, "haziness": h, "cloudiness": cl, "sun_zenith_deg": 90 - e, "width": DOME[0], "height": DOME[1],
+                         "white_cd_m2": white} for n, h, cl, e, white in DISPLAY_VIEWS],
             "weights": [[h, cl] for _, h, cl in VIEWS] + [[0.0, 0.1], [0.0, 0.4], [1.0, 1.0]],
             "fog": [{"sky": s, "points": [dict(zip(["sun_zenith_deg", "view_zenith_deg", "relative_azimuth_deg", "depth_m",
                                                     "occlusion"], p)) for p in cls.fog_points]} for s in ("clear", "hazed")],
@@ -299,6 +316,22 @@ class ViewerTest(TempDirTestCase):
                 self.assertLessEqual(mx, MAX_TOLERANCE, lines[-1])
         print("\n" + "\n".join(lines))
 
+    def test_display_view_matches_the_ocio_cpu_preview(self):
+        # OCIO's GLSL (luts/display.json) on the GPU against OCIO's CPU processor (the PNG previews'
+        # path) on the same decoded radiance: every 8-bit code within one step (the radiance
+        # differs by the float32 decode, ~1e-6, and a value can fall either side of a rounding
+        # boundary), and almost all equal.
+        for res in self.result["display"]:
+            w, h, ch, px = self.display_png[res["name"]]
+            self.assertEqual((w, h, ch), (DOME[0], DOME[1], 3))
+            diff = [abs(a - b) for a, b in zip(res["codes"], px)]
+            self.assertEqual(len(diff), w * h * 3)
+            same = sum(1 for d in diff if d == 0) / len(diff)
+            print("\ndisplay %-9s max |code difference| %d, %.2f %% equal" % (res["name"], max(diff), 100 * same))
+            self.assertLessEqual(max(diff), 1, res["name"])
+            self.assertGreater(same, 0.98, res["name"])
+            self.assertGreater(len(set(px)), 20, "the %s preview is not a picture" % res["name"])
+
     def test_fog_points_match_the_reference_evaluator(self):
         k = self.result["luminance_from_rgb"]
         for res in self.result["fog"]:
@@ -350,7 +383,7 @@ SCREENSHOTS = [
     {"name": "fog", "state": {"sunElevationDeg": 10, "haziness": 1, "cloudiness": 0, "clouds": False, "fog": True, "ev": 11.5,
                               "pitchDeg": -2, "yawDeg": 30}},
     {"name": "clouds", "state": {"sunElevationDeg": 25, "haziness": 0.2, "cloudiness": 0.1, "clouds": True, "fog": True,
-                                 "ev": 12.5, "pitchDeg": 15, "yawDeg": 200, "cloudSteps": 32}},
+                                 "ev": 12.5, "pitchDeg": 15, "yawDeg": 200, "cloudSteps": 160}},
 ]
 
 

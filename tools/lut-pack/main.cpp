@@ -27,6 +27,7 @@
 #include "io/cli.h"
 #include "io/error.h"
 #include "io/fileio.h"
+#include "io/png.h"
 #include "io/yaml.h"
 #include "lut/check.h"
 #include "lut/decoder.h"
@@ -105,6 +106,12 @@ int main(int argc, char** argv) {
       ->required();
   decode->add_option("--time-interpolation", interp, "Blend of neighbouring slices: geometric (default) or linear (the talk's lerp)")
       ->check(CLI::IsMember({"geometric", "linear"}));
+  std::string decode_preview;
+  double decode_white = 0.0;
+  decode->add_option("--preview", decode_preview, "Also write the domes through the OCIO sRGB display view as a PNG");
+  decode->add_option("--white-cd-m2", decode_white, "The preview's white: the luminance shown as display white (cd/m^2)")
+      ->check(CLI::PositiveNumber);
+  decode->add_option("--ocio-config", ocio_config, "OCIO config (default: $SKYBAKE_OCIO or the repo's ocio/config.ocio)");
 
   // LUT.ktx2[:WEIGHT] -> path and weight (UsageError otherwise).
   auto split_weighted = [](const std::string& l) {
@@ -127,6 +134,7 @@ int main(int argc, char** argv) {
 
   return cli.Run(argc, argv, [&] {
     if (decode->parsed()) {
+      if (!decode_preview.empty() && !(decode_white > 0.0)) throw UsageError("--preview needs --white-cd-m2");
       int w = 0, h = 0;
       char tail = 0;
       if (std::sscanf(decode_size.c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192) {
@@ -167,7 +175,15 @@ int main(int argc, char** argv) {
                                     decode_size, interp);
       for (const std::string& l : decode_luts) prov.AddInput(split_weighted(l).first);
       SetProvenance(img, prov);
+      std::string png;
+      if (!decode_preview.empty()) {
+        const ColorConfig config = ColorConfig::Load(ocio_config);
+        const ColorProcessor view = config.Display(ocio_names::kLinearRec2020, DisplayView{.white_cd_m2 = decode_white});
+        std::vector<float> rgb(img.pixels);
+        png = EncodePng8(img.width, img.height, 3, EncodePreview8(img.width, img.height, rgb, view));
+      }
       WriteExr(decode_out, img);
+      if (!decode_preview.empty()) WriteFileIfChanged(decode_preview, png);
       cli.Info(fmt::format("{} dome{} of {}x{} for {}", decode_sza.size(), decode_sza.size() == 1 ? "" : "s", w, h, desc));
       return;
     }

@@ -24,7 +24,7 @@ uniform vec2 uCumulusMap;    // skybake.mapping.a, skybake.mapping.half_extent_m
 uniform vec2 uCoverageAlt;   // altitudes of the coverage texture's first and last rows (m)
 uniform vec2 uCoverageSize;  // its W x H
 uniform float uCloudTypes;   // its layers
-uniform float uCloudSteps;   // ray-march steps through the layer
+uniform float uCloudSteps;   // the most ray-march steps through the layer
 
 in vec2 vUv;
 layout(location = 0) out vec4 outColor;
@@ -119,17 +119,21 @@ vec4 clouds(vec3 d, vec3 sunW, vec3 eSun, vec3 eAmb) {
   if (t1 <= 0.0 || d.z < -0.05) return vec4(0.0, 0.0, 0.0, 1.0);
   t0 = max(t0, 0.0);
   t1 = min(t1, t0 + 60000.0);  // at most 60 km of the layer (GT7's map spans 240 km)
-  float dt = (t1 - t0) / uCloudSteps;
-  // A fixed per-pixel offset of the first sample (interleaved gradient noise, Jimenez 2014) breaks
-  // the steps' banding; it is the same every frame, so the images are deterministic.
+  // Steps grow with the distance (2 % of it, 40 m to 1 km): the detail a pixel can show. A fixed
+  // per-pixel offset of the first step (interleaved gradient noise, Jimenez 2014, "Next
+  // Generation Post Processing in Call of Duty: Advanced Warfare") breaks the banding and stays
+  // the same every frame, so the images are deterministic.
   float jitter = fract(52.9829189 * fract(dot(gl_FragCoord.xy, vec2(0.06711056, 0.00583715))));
   float cosTheta = dot(d, sunW);
   vec3 l = vec3(0.0);
   float tr = 1.0;
-  for (int i = 0; i < 256; ++i) {
-    if (float(i) >= uCloudSteps || tr < 0.01) break;
-    float t = t0 + (float(i) + jitter) * dt;
-    vec3 p = d * t;
+  float t = t0;
+  for (int i = 0; i < 512; ++i) {
+    if (float(i) >= uCloudSteps || tr < 0.01 || t >= t1) break;
+    float dt = clamp(0.02 * t, 40.0, 1000.0);
+    float ts = t + jitter * dt;
+    t += dt;
+    vec3 p = d * ts;
     vec2 rho = cloudDensity(p, altitudeOf(p));
     if (rho.x <= 0.0) continue;
     float sigma = rho.x * kSigmaMax;

@@ -120,7 +120,7 @@ function sunFromTime(hours, latDeg, dayOfYear) {
 export const state = {
   sunElevationDeg: 20, sunAzimuthDeg: 0, useTime: false, hours: 16, latitudeDeg: 45, day: 172,
   haziness: 0, cloudiness: 0, fog: true, clouds: true, ev: 13, falseColour: false,
-  yawDeg: 0, pitchDeg: 5, fovDeg: 70, cloudSteps: 48,
+  yawDeg: 0, pitchDeg: 5, fovDeg: 70, cloudSteps: 160,
 };
 
 function sunOf(s) {
@@ -350,6 +350,45 @@ class Viewer {
     return { views: out, fetchesPerPixel: fetches / (width * height * sunZenithDeg.length) };
   }
 
+  // The dome of the weighted blend at one sun zenith angle through the display pass (exposure
+  // 1 / white, the OCIO sRGB view) into an RGBA8 target: W*H*3 display codes, rows top to bottom.
+  // The check that the viewer and the PNG previews (OCIO's CPU path) show the same picture.
+  domeDisplay(weights, sunZenithDeg, width, height, whiteCdM2) {
+    const gl = this.gl;
+    const hdr = floatTarget(gl, width, height);
+    let prog = this.programs.dome;
+    gl.useProgram(prog.p);
+    this.bindSky(prog, weights);
+    setUniform(gl, prog, "uSunZenith", sunZenithDeg * DEG);
+    setUniform(gl, prog, "uDomeSize", [width, height]);
+    this.draw(prog, hdr);
+    const tex = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, tex);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA8, width, height, 0, gl.RGBA, gl.UNSIGNED_BYTE, null);
+    const fb = gl.createFramebuffer();
+    gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, tex, 0);
+    prog = this.programs.display;
+    gl.useProgram(prog.p);
+    bindSampler(gl, prog, "uHdr", gl.TEXTURE_2D, hdr.textures[0]);
+    setUniform(gl, prog, "uExposure", 1 / whiteCdM2);
+    setUniform(gl, prog, "uFalseColour", 0);
+    setUniform(gl, prog, "uLuminance", this.bake.display.luminance_from_rgb);
+    this.draw(prog, { fb, w: width, h: height });
+    const px = new Uint8Array(width * height * 4);
+    gl.bindFramebuffer(gl.READ_FRAMEBUFFER, fb);
+    gl.readPixels(0, 0, width, height, gl.RGBA, gl.UNSIGNED_BYTE, px);
+    gl.bindFramebuffer(gl.READ_FRAMEBUFFER, null);
+    gl.deleteFramebuffer(fb);
+    gl.deleteTexture(tex);
+    hdr.free();
+    const out = new Array(width * height * 3);
+    for (let y = 0; y < height; ++y) {
+      for (let x = 0; x < width; ++x) for (let c = 0; c < 3; ++c) out[(y * width + x) * 3 + c] = px[((height - 1 - y) * width + x) * 4 + c];
+    }
+    return out;
+  }
+
   // Fog of one sky at explicit points [{sun_zenith_deg, view_zenith_deg, relative_azimuth_deg,
   // depth_m, occlusion}]: [{inscattered: [r, g, b], transmittance: [r, g, b]}].
   fogPoints(sky, points) {
@@ -487,7 +526,7 @@ async function start() {
         pending = false;
         const t0 = performance.now();
         viewer.frame(state);
-        viewer.gl.finish();
+        viewer.gl.readPixels(0, 0, 1, 1, viewer.gl.RGBA, viewer.gl.UNSIGNED_BYTE, new Uint8Array(4));  // waits for the frame
         const sun = sunOf(state);
         $("info").textContent = `sun elevation ${(90 - sun.zenith / DEG).toFixed(2)}°, ` +
           `frame ${(performance.now() - t0).toFixed(0)} ms; skies ` +
@@ -504,15 +543,18 @@ async function start() {
       // Renders the game view with `overrides` of the state, synchronously, onto the canvas.
       show(overrides) { Object.assign(state, overrides); viewer.frame(state); viewer.gl.finish(); return true; },
       domes: (weights, sza, w, h) => viewer.domes(weights, sza, w, h),
+      domeDisplay: (weights, sza, w, h, white) => viewer.domeDisplay(weights, sza, w, h, white),
       fogPoints: (sky, points) => viewer.fogPoints(sky, points),
       fetchCounts: (overrides) => { Object.assign(state, overrides); return viewer.fetchCounts(state); },
-      // Mean time of `frames` frames of the game view (ms), each finished with gl.finish.
+      // Mean time of `frames` frames of the game view (ms). Each frame ends with a one-pixel
+      // readPixels of the canvas, which waits for the GPU (gl.finish does not in Chromium).
       frameTime(overrides, frames = 5) {
         Object.assign(state, overrides);
-        viewer.frame(state);
-        viewer.gl.finish();
+        const gl = viewer.gl, px = new Uint8Array(4);
+        const one = () => { viewer.frame(state); gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, px); };
+        one();
         const t0 = performance.now();
-        for (let i = 0; i < frames; ++i) { viewer.frame(state); viewer.gl.finish(); }
+        for (let i = 0; i < frames; ++i) one();
         return (performance.now() - t0) / frames;
       },
       glError: () => viewer.gl.getError(),
