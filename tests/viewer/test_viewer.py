@@ -371,20 +371,8 @@ class ViewerTest(TempDirTestCase):
             self.assertGreater(stats["max_luminance"], 0, path)
 
 
-SCREENSHOTS = [
-    {"name": "noon", "state": {"sunElevationDeg": 60, "haziness": 0, "cloudiness": 0, "clouds": False, "fog": True, "ev": 13.5,
-                               "pitchDeg": 12, "yawDeg": 180}},
-    {"name": "sunset", "state": {"sunElevationDeg": 2, "haziness": 0.4, "cloudiness": 0, "clouds": False, "fog": True, "ev": 10,
-                                 "pitchDeg": 5, "yawDeg": 10}},
-    {"name": "twilight", "state": {"sunElevationDeg": -4, "haziness": 0, "cloudiness": 0, "clouds": False, "fog": True, "ev": 5,
-                                   "pitchDeg": 10, "yawDeg": 0}},
-    {"name": "overcast", "state": {"sunElevationDeg": 40, "haziness": 0, "cloudiness": 1, "clouds": False, "fog": True, "ev": 11,
-                                   "pitchDeg": 10, "yawDeg": 90}},
-    {"name": "fog", "state": {"sunElevationDeg": 10, "haziness": 1, "cloudiness": 0, "clouds": False, "fog": True, "ev": 11.5,
-                              "pitchDeg": -2, "yawDeg": 30}},
-    {"name": "clouds", "state": {"sunElevationDeg": 25, "haziness": 0.2, "cloudiness": 0.1, "clouds": True, "fog": True,
-                                 "ev": 12.5, "pitchDeg": 15, "yawDeg": 200, "cloudSteps": 160}},
-]
+with open(os.path.join(SRC, "viewer", "presets.json")) as _f:
+    SCREENSHOTS = json.load(_f)["presets"]  # noon, sunset, twilight, overcast, fog, clouds
 
 
 def drive(outputs, plan, shots_dir, work):
@@ -396,7 +384,7 @@ def drive(outputs, plan, shots_dir, work):
         json.dump(plan, f)
     result_path = os.path.join(work, "result.json")
     server = subprocess.Popen([sys.executable, os.path.join(SRC, "scripts", "view_server.py"), "--outputs", outputs,
-                               "--port", "0", "--print-port"], stdout=subprocess.PIPE, text=True)
+                               "--port", "0", "--print-port", "--quiet"], stdout=subprocess.PIPE, text=True)
     try:
         port = int(server.stdout.readline().strip())
         r = run(["node", os.path.join(SRC, "tests", "viewer", "drive.mjs"), "--url", "http://127.0.0.1:%d/" % port,

@@ -169,8 +169,14 @@ void main() {
   float depth = 0.0;
   if (d.z >= 0.0) {
     color = skyBlend(toSunFrame(d), zs);
-    float g = acos(clamp(dot(d, sunW), -1.0, 1.0));
-    color += sbSunDisk(eSun, g, uSunRadius);
+    // The sun disk: the sun LUT's illuminance, each point of the disk through the transmittance
+    // of its own view zenith (the lower limb redder and dimmer near the horizon): E0 T(z_pixel)
+    // with E0 = E_sun / T(z_sun).
+    float g = atan(length(cross(d, sunW)), dot(d, sunW));  // the angle from the sun (acos loses it near 1)
+    if (g < uSunRadius) {
+      vec3 t = transmittanceBlend(atan(length(d.xy), d.z)) / max(transmittanceBlend(zs), vec3(1e-12));
+      color += sbSunDisk(eSun * t, g, uSunRadius);
+    }
     if (uCloudsOn > 0.5) {
       vec4 c = clouds(d, sunW, eSun, eAmb);
       color = color * c.a + c.rgb;

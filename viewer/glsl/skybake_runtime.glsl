@@ -59,8 +59,8 @@ float sbSliceZenith(SbTimeMapping tm, float i) {
     if (i <= 0.0) return 0.0;
     if (i >= tm.upper - 1.0) return 0.5 * SB_PI;
     float d = mix(sbDMin(tm), sbDMax(tm), pow(i / (tm.upper - 1.0), tm.power));
-    float c = ((tm.R - tm.r) * (tm.R + tm.r) - d * d) / (2.0 * tm.r * d);
-    return acos(clamp(c, -1.0, 1.0));
+    float c = clamp(((tm.R - tm.r) * (tm.R + tm.r) - d * d) / (2.0 * tm.r * d), -1.0, 1.0);
+    return atan(sqrt((1.0 - c) * (1.0 + c)), c);  // acos(c), without acos' loss near c = 1 on some GPUs
   }
   float f = (i - tm.upper) / (tm.lower - 1.0);
   return (90.0 + 10.0 * f * f) * SB_DEG;
@@ -227,11 +227,15 @@ float sbFogBoundary(SbFog f, float mu) {
   return k / (r * mu + sqrt(r * r * mu * mu + k));
 }
 
+// The elevation asin(mu) of a zenith cosine mu in [0, 1], as an atan (asin, like acos, loses
+// precision next to 1 in some GPUs' approximations).
+float sbElevation(float mu) { return atan(mu, sqrt((1.0 - mu) * (1.0 + mu))); }
+
 // The normalised view angle theta of k = a theta^p.
 float sbFogTheta(SbFog f, float mu) {
   mu = clamp(mu, 0.0, 1.0);
   if (f.pathAngle > 0.5) return (f.cutAltitude - f.observerAltitude) / sbFogBoundary(f, mu);
-  return asin(mu) / (0.5 * SB_PI);
+  return sbElevation(mu) / (0.5 * SB_PI);
 }
 
 // F(x, k) = (1 - e^{-kx}) / (1 - e^{-k}), k = a theta^p (theta in [1e-6, 1], k in [0, 1e6]);
@@ -244,7 +248,7 @@ vec3 sbDepthFactor(float x, vec3 a, vec3 p, float theta) {
 }
 
 // The attenuation LUT's v = (elevation / 90 deg)^(1/2) (always the elevation).
-float sbAttenuationV(float mu) { return sqrt(asin(clamp(mu, 0.0, 1.0)) / (0.5 * SB_PI)); }
+float sbAttenuationV(float mu) { return sqrt(sbElevation(clamp(mu, 0.0, 1.0)) / (0.5 * SB_PI)); }
 
 // a and p of one slice k at v: p at texel (0, k), a at texels (1 + j, k) of the parameter
 // texture (fog_<sky>_params.ktx2, RGBA32F 2D array, layer 0 fog, 1 shadowed fog; + 2 sky when

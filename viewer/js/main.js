@@ -446,18 +446,26 @@ const FALSE_COLOUR_RANGE = [-1, 5];  // log10 cd/m^2: 0.1 to 100 000 cd/m^2
 
 // ----------------------------------------------------------------------------------- page
 
+const CONTROLS = [
+  ["sunElevation", "sunElevationDeg"], ["sunAzimuth", "sunAzimuthDeg"], ["hours", "hours"], ["latitude", "latitudeDeg"],
+  ["haziness", "haziness"], ["cloudiness", "cloudiness"], ["ev", "ev"], ["fov", "fovDeg"],
+];
+const CHECKBOXES = [["fog", "fog"], ["clouds", "clouds"], ["falseColour", "falseColour"], ["useTime", "useTime"]];
+
+// The controls show the state (after a preset or a test set it).
+function syncControls() {
+  for (const [id, key] of CONTROLS) $(id).value = state[key];
+  for (const [id, key] of CHECKBOXES) $(id).checked = state[key];
+}
+
 function bindControls(viewer, redraw) {
   const s = state;
-  const controls = [
-    ["sunElevation", "sunElevationDeg"], ["sunAzimuth", "sunAzimuthDeg"], ["hours", "hours"], ["latitude", "latitudeDeg"],
-    ["haziness", "haziness"], ["cloudiness", "cloudiness"], ["ev", "ev"], ["fov", "fovDeg"],
-  ];
-  for (const [id, key] of controls) {
+  for (const [id, key] of CONTROLS) {
     const el = $(id);
     el.value = s[key];
     el.addEventListener("input", () => { s[key] = Number(el.value); redraw(); });
   }
-  for (const [id, key] of [["fog", "fog"], ["clouds", "clouds"], ["falseColour", "falseColour"], ["useTime", "useTime"]]) {
+  for (const [id, key] of CHECKBOXES) {
     const el = $(id);
     el.checked = s[key];
     el.addEventListener("change", () => { s[key] = el.checked; redraw(); });
@@ -534,6 +542,13 @@ async function start() {
       });
     };
     bindControls(viewer, redraw);
+    const presets = (await (await fetch("presets.json")).json()).presets;
+    for (const p of presets) {
+      const button = document.createElement("button");
+      button.textContent = p.name;
+      button.addEventListener("click", () => { Object.assign(state, p.state); syncControls(); redraw(); });
+      $("presets").appendChild(button);
+    }
     drawScale();
     redraw();
     log(`${base}: ${viewer.bake.names.length} basis skies` + (viewer.bake.fog ? ", fog" : "") + (viewer.bake.clouds ? ", clouds" : ""));
@@ -541,7 +556,8 @@ async function start() {
       viewer, state, weatherWeights: (h, c) => weatherWeights(viewer.bake, h, c),
       names: viewer.bake.names, fogSkies: viewer.bake.fog ? viewer.bake.fog.names : [], hasClouds: !!viewer.bake.clouds,
       // Renders the game view with `overrides` of the state, synchronously, onto the canvas.
-      show(overrides) { Object.assign(state, overrides); viewer.frame(state); viewer.gl.finish(); return true; },
+      presets,
+      show(overrides) { Object.assign(state, overrides); syncControls(); viewer.frame(state); viewer.gl.finish(); return true; },
       domes: (weights, sza, w, h) => viewer.domes(weights, sza, w, h),
       domeDisplay: (weights, sza, w, h, white) => viewer.domeDisplay(weights, sza, w, h, white),
       fogPoints: (sky, points) => viewer.fogPoints(sky, points),
