@@ -14,7 +14,7 @@ import struct
 import tempfile
 import unittest
 
-from skytest import SRC, CliContract, TempDirTestCase, run, tool
+from skytest import exr_attributes, SRC, CliContract, TempDirTestCase, run, tool
 from test_noise_gen import ktx_level, ktx_parse
 
 CLEAR = os.path.join(SRC, "atmospheres", "clear.yaml")
@@ -226,6 +226,64 @@ class LutPackCli(CliContract, TempDirTestCase):
         self.assertAlmostEqual(a["rms_upper_all"], b["rms_upper_all"], places=6)
         r = run([tool("lut-pack"), "check", lut + ":x", "--direct", self.equirect, "-o", half])
         self.assertEqual(r.returncode, 2)
+
+    def dome(self, out, *luts, extra=()):
+        r = run([tool("lut-pack"), "decode"] + list(luts) + ["--sun-zenith-deg", "30,89.5,95", "--size", "8x4", "-o", out]
+                + list(extra))
+        self.assertEqual(r.returncode, 0, r.stderr)
+        dump = run(["oiiotool", "--dumpdata", out]).stdout
+        return [float(v) for line in dump.splitlines() if line.strip().startswith("Pixel")
+                for v in line.split(":")[1].split()[:3]]
+
+    def test_decode_writes_domes_and_blends_linearly(self):
+        # The weighted blend is sum_k w_k L_k (lut/decoder.h BlendRadiance): a 0.25 / 0.75 blend
+        # of two skies equals the same sum of their single decodes; 3 sun angles stack 3 domes.
+        self.assertEqual(self.pack(self.tmp).returncode, 0)
+        a, b = self.path("sky_sunny.ktx2"), self.path("sky_cloudy.ktx2")
+        da = self.dome(self.path("a.exr"), a)
+        db = self.dome(self.path("b.exr"), b)
+        mix = self.dome(self.path("mix.exr"), a + ":0.25", b + ":0.75")
+        self.assertEqual(len(da), 8 * 4 * 3 * 3)
+        self.assertGreater(min(da), 0.0)
+        for x, y, m in zip(da, db, mix):
+            self.assertAlmostEqual(m, 0.25 * x + 0.75 * y, delta=2e-6 * max(1.0, m))
+        kv = exr_attributes(self.path("a.exr"))
+        self.assertEqual(kv["skybake.sun_zenith_deg"], "30 89.5 95")
+        self.assertIn("dome", kv["skybake.mapping"])
+        # The 95 deg dome is below the last slice... of this 5-slice set (100 deg): still decoded, and darker.
+        n = 8 * 4 * 3
+        self.assertLess(sum(da[2 * n:]), sum(da[n:2 * n]))
+
+    def test_decode_preview_and_bad_arguments(self):
+        self.assertEqual(self.pack(self.tmp).returncode, 0)
+        lut = self.path("sky_sunny.ktx2")
+        png = self.path("dome.png")
+        self.dome(self.path("d.exr"), lut, extra=["--preview", png, "--white-cd-m2", "5000"])
+        with open(png, "rb") as f:
+            self.assertEqual(f.read(8), b"\x89PNG\r\n\x1a\n")
+        for bad in (["--sun-zenith-deg", "nan"], ["--sun-zenith-deg", "181"], ["--sun-zenith-deg", "30", "--size", "0x4"],
+                    ["--sun-zenith-deg", "30", "--preview", png], ["--sun-zenith-deg", "30", "--preview", png,
+                                                                   "--white-cd-m2", "inf"]):
+            out = self.path("bad.exr")
+            r = run([tool("lut-pack"), "decode", lut, "-o", out] + bad)
+            self.assertEqual(r.returncode, 2, (bad, r.stderr))
+            self.assertTrue(r.stderr.startswith("lut-pack: "), r.stderr)
+            self.assertFalse(os.path.exists(out), bad)
+        r = run([tool("lut-pack"), "decode", lut + ":inf", "--sun-zenith-deg", "30", "-o", self.path("bad.exr")])
+        self.assertEqual(r.returncode, 2, r.stderr)
+        r = run([tool("lut-pack"), "decode", self.path("missing.ktx2"), "--sun-zenith-deg", "30", "-o", self.path("bad.exr")])
+        self.assertEqual(r.returncode, 1, r.stderr)
+        self.assertIn("missing.ktx2", r.stderr)
+
+    def test_display_json_is_ocio_glsl_and_the_luminance_row(self):
+        self.assertEqual(self.pack(self.tmp).returncode, 0)
+        with open(self.path("display.json")) as f:
+            d = json.load(f)
+        self.assertIn("vec4 OCIODisplay(vec4 inPixel)", d["glsl"])
+        self.assertEqual(d["input_colorspace"], "Linear Rec.2020")
+        # ITU-R BT.2100 / BT.2020 luminance coefficients 0.2627, 0.6780, 0.0593 (Rec. ITU-R BT.2020-2, Table 4).
+        for got, want in zip(d["luminance_from_rgb"], (0.2627, 0.6780, 0.0593)):
+            self.assertAlmostEqual(got, want, places=4)
 
 
 if __name__ == "__main__":

@@ -134,7 +134,9 @@ int main(int argc, char** argv) {
 
   return cli.Run(argc, argv, [&] {
     if (decode->parsed()) {
-      if (!decode_preview.empty() && !(decode_white > 0.0)) throw UsageError("--preview needs --white-cd-m2");
+      if (!decode_preview.empty() && !(decode_white > 0.0 && std::isfinite(decode_white))) {
+        throw UsageError("--preview needs --white-cd-m2 with a finite positive luminance");
+      }
       int w = 0, h = 0;
       char tail = 0;
       if (std::sscanf(decode_size.c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192) {
