@@ -36,7 +36,8 @@ inline std::vector<std::string> LutSkyFiles(const std::string& sky) {
   return {"sky_" + sky + ".ktx2", "sky_" + sky + "_array.ktx2", "sky_" + sky + ".dds", "sky_" + sky + ".exr"};
 }
 inline std::vector<std::string> LutSetFiles() {
-  return {"transmittance.ktx2", "transmittance.dds", "sun.ktx2", "sun.dds", "ambient.ktx2", "ambient.dds", "other_luts.exr"};
+  return {"transmittance.ktx2", "transmittance.dds", "sun.ktx2", "sun.dds", "ambient.ktx2", "ambient.dds", "other_luts.exr",
+          "contact_sheet.png"};
 }
 
 // outputs/<atm>/fog.exr: sky-render fog (the reference fog of the low atmosphere) for fog-fit.
