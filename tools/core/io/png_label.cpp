@@ -142,6 +142,17 @@ uint8_t Blend(uint8_t under, uint8_t over, uint8_t a) {
   return static_cast<uint8_t>((over * a + under * (255 - a) + 127) / 255);
 }
 
+// Whether `b` (grown by `pad` px) meets any of `drawn`: labels that would touch one already drawn
+// are left out, so that crowded ticks stay readable.
+bool Overlaps(const PixelBox& b, const std::vector<PixelBox>& drawn, int pad = 2) {
+  for (const PixelBox& d : drawn) {
+    if (b.x0 - pad < d.x1 && d.x0 < b.x1 + pad && b.y0 - pad < d.y1 && d.y0 < b.y1 + pad) return true;
+  }
+  return false;
+}
+
+PixelBox Moved(PixelBox b, int dx, int dy) { return {b.x0 + dx, b.y0 + dy, b.x1 + dx, b.y1 + dy}; }
+
 }  // namespace
 
 std::filesystem::path Font::ResolvePath() {
@@ -310,16 +321,21 @@ void DrawScaleBar(Canvas& canvas, const Font& font, const ScaleBar& s) {
   }
   canvas.Frame({b.x0 - 1, b.y0 - 1, b.x1 + 1, b.y1 + 1}, s.ink);
   constexpr int kTick = 4, kPad = 2;
+  std::vector<PixelBox> drawn;
   for (const ScaleTick& t : s.ticks) {
+    const PixelBox ink = font.InkBox(t.label, s.text_px);
     if (s.vertical) {
       const int y = b.y1 - 1 - static_cast<int>(std::lround(std::clamp(t.at, 0.0, 1.0) * (b.height() - 1)));
       canvas.HLine(b.x1 + 1, b.x1 + 1 + kTick, y, s.ink);
-      const PixelBox ink = font.InkBox(t.label, s.text_px);
-      canvas.Text(font, t.label, s.text_px, b.x1 + 1 + kTick + kPad, y - (ink.y0 + ink.y1) / 2, s.ink);
+      const int x = b.x1 + 1 + kTick + kPad, base = y - (ink.y0 + ink.y1) / 2;
+      if (Overlaps(Moved(ink, x, base), drawn)) continue;
+      drawn.push_back(canvas.Text(font, t.label, s.text_px, x, base, s.ink));
     } else {
       const int x = b.x0 + static_cast<int>(std::lround(std::clamp(t.at, 0.0, 1.0) * (b.width() - 1)));
       canvas.VLine(x, b.y1 + 1, b.y1 + 1 + kTick, s.ink);
-      canvas.Text(font, t.label, s.text_px, x, b.y1 + 1 + kTick + kPad + font.Ascent(s.text_px), s.ink, Align::kCentre);
+      const int base = b.y1 + 1 + kTick + kPad + font.Ascent(s.text_px), left = x - font.Advance(t.label, s.text_px) / 2;
+      if (Overlaps(Moved(ink, left, base), drawn)) continue;
+      drawn.push_back(canvas.Text(font, t.label, s.text_px, left, base, s.ink));
     }
   }
   if (!s.title.empty()) canvas.Text(font, s.title, s.text_px, b.x0, b.y0 - 1 - kPad - font.Descent(s.text_px), s.ink);
@@ -327,24 +343,71 @@ void DrawScaleBar(Canvas& canvas, const Font& font, const ScaleBar& s) {
 
 namespace {
 
+// Greedy word wrap of `text` at `px` into lines no wider than `width` (a word wider than that
+// gets a line of its own).
+std::vector<std::string> Wrap(const Font& font, const std::string& text, double px, int width) {
+  std::vector<std::string> lines;
+  std::string line, word;
+  auto flush_word = [&] {
+    if (word.empty()) return;
+    const std::string joined = line.empty() ? word : line + " " + word;
+    if (line.empty() || font.Advance(joined, px) <= width) {
+      line = joined;
+    } else {
+      lines.push_back(line);
+      line = word;
+    }
+    word.clear();
+  };
+  for (char c : text) {
+    if (c == ' ') {
+      flush_word();
+    } else {
+      word += c;
+    }
+  }
+  flush_word();
+  if (!line.empty() || lines.empty()) lines.push_back(line);
+  return lines;
+}
+
+// `text` at `px` shrunk down to 9 px to fit `width`, then cut with "…" if it still does not.
+std::pair<std::string, double> FitLine(const Font& font, std::string text, double px, int width) {
+  while (px > 9.0 && font.Advance(text, px) > width) px -= 0.5;
+  if (font.Advance(text, px) <= width) return {text, px};
+  while (!text.empty() && font.Advance(text + "\u2026", px) > width) {
+    do {
+      text.pop_back();
+    } while (!text.empty() && (static_cast<unsigned char>(text.back()) & 0xC0) == 0x80);
+    if (!text.empty() && static_cast<unsigned char>(text.back()) >= 0xC0) text.pop_back();  // a lead byte
+  }
+  return {text + "\u2026", px};
+}
+
 struct SheetLayout {
   static constexpr int kMargin = 10, kGap = 8, kRowLabel = 16, kXAxis = 36, kYAxis = 56, kValue = 84;
+  static constexpr double kTitlePx = 15, kSubtitlePx = 11;
   int title_h = 0, header_h = 0, pw = 0, ph = 0, rows = 0, cols = 0, left = 0, bottom = 0;
   int width = 0, height = 0;
+  std::vector<std::pair<std::string, double>> title;  // wrapped lines and their sizes
 
-  explicit SheetLayout(const PanelSheet& s) {
+  SheetLayout(const PanelSheet& s, const Font& font) {
     rows = static_cast<int>(s.panels.size());
     SKYBAKE_CHECK(rows > 0 && !s.panels[0].empty());
     cols = static_cast<int>(s.panels[0].size());
     pw = s.panels[0][0].width * s.zoom;
     ph = s.panels[0][0].height * s.zoom;
-    title_h = s.title_lines.empty() ? 0 : 6 + 16 * static_cast<int>(s.title_lines.size());
     int lines = 0;
     for (const std::string& h : s.column_headers) lines = std::max(lines, 1 + static_cast<int>(std::count(h.begin(), h.end(), '\n')));
     header_h = lines * 14 + (lines ? 4 : 0);
     left = s.y_axis.ticks.empty() ? 0 : kYAxis;
     bottom = s.x_axis.ticks.empty() ? 0 : kXAxis;
     width = 2 * kMargin + left + cols * pw + (cols - 1) * kGap + (s.value_ticks.empty() ? 0 : kValue);
+    for (size_t i = 0; i < s.title_lines.size(); ++i) {
+      const double px = i == 0 ? kTitlePx : kSubtitlePx;
+      for (const std::string& l : Wrap(font, s.title_lines[i], px, width - 2 * kMargin)) title.emplace_back(l, px);
+    }
+    title_h = title.empty() ? 0 : 6 + 16 * static_cast<int>(title.size());
     height = 2 * kMargin + title_h + header_h + rows * (kRowLabel + ph) + (rows - 1) * kGap + bottom;
   }
   int PanelX(int c) const { return kMargin + left + c * (pw + kGap); }
@@ -365,31 +428,29 @@ std::vector<std::string> SplitLines(const std::string& s) {
 
 }  // namespace
 
-std::pair<int, int> PanelSheetSize(const PanelSheet& sheet) {
-  const SheetLayout l(sheet);
+std::pair<int, int> PanelSheetSize(const PanelSheet& sheet, const Font& font) {
+  const SheetLayout l(sheet, font);
   return {l.width, l.height};
 }
 
 std::string RenderPanelSheet(const PanelSheet& s, const Font& font) {
-  const SheetLayout l(s);
+  const SheetLayout l(s, font);
   const Rgb8 bg{40, 40, 40}, ink{232, 232, 232}, dim{175, 175, 175};
   Canvas canvas(l.width, l.height, bg);
-  auto fit = [&](const std::string& text, double px, int width) {
-    while (px > 8.0 && font.Advance(text, px) > width) px -= 0.5;
-    return px;
-  };
-  const int text_w = l.width - 2 * SheetLayout::kMargin;
-  for (size_t i = 0; i < s.title_lines.size(); ++i) {
-    const double px = i == 0 ? 15 : 11;
-    canvas.Text(font, s.title_lines[i], fit(s.title_lines[i], px, text_w), SheetLayout::kMargin,
+  for (size_t i = 0; i < l.title.size(); ++i) {
+    canvas.Text(font, l.title[i].first, l.title[i].second, SheetLayout::kMargin,
                 SheetLayout::kMargin + 15 + 16 * static_cast<int>(i), i == 0 ? ink : dim);
   }
+  auto draw_fitted = [&](const std::string& text, double px, int width, int x, int y, Rgb8 c, Align a) {
+    const auto [t, size] = FitLine(font, text, px, width);
+    canvas.Text(font, t, size, x, y, c, a);
+  };
   const int y_header = SheetLayout::kMargin + l.title_h;
   for (int c = 0; c < l.cols && c < static_cast<int>(s.column_headers.size()); ++c) {
     const std::vector<std::string> lines = SplitLines(s.column_headers[c]);
     for (size_t k = 0; k < lines.size(); ++k) {
-      canvas.Text(font, lines[k], fit(lines[k], 11, l.pw + SheetLayout::kGap), l.PanelX(c) + l.pw / 2,
-                  y_header + 12 + 14 * static_cast<int>(k), k == 0 ? ink : dim, Align::kCentre);
+      draw_fitted(lines[k], 11, l.pw + SheetLayout::kGap - 2, l.PanelX(c) + l.pw / 2, y_header + 12 + 14 * static_cast<int>(k),
+                  k == 0 ? ink : dim, Align::kCentre);
     }
   }
   for (int r = 0; r < l.rows; ++r) {
@@ -397,7 +458,7 @@ std::string RenderPanelSheet(const PanelSheet& s, const Font& font) {
     const int y0 = l.PanelY(r);
     if (r < static_cast<int>(s.row_labels.size())) {
       const int row_w = l.cols * l.pw + (l.cols - 1) * SheetLayout::kGap;
-      canvas.Text(font, s.row_labels[r], fit(s.row_labels[r], 11, row_w), l.PanelX(0), y0 - 4, ink);
+      draw_fitted(s.row_labels[r], 11, row_w, l.PanelX(0), y0 - 4, ink, Align::kLeft);
     }
     for (int c = 0; c < l.cols; ++c) {
       const GreyPanel& p = s.panels[r][c];
@@ -413,14 +474,18 @@ std::string RenderPanelSheet(const PanelSheet& s, const Font& font) {
     }
     if (!s.y_axis.ticks.empty()) {  // left of the first column, every row
       const int x = l.PanelX(0);
+      std::vector<PixelBox> drawn;
       for (const ScaleTick& t : s.y_axis.ticks) {
         const int y = y0 + l.ph - 1 - static_cast<int>(std::lround(std::clamp(t.at, 0.0, 1.0) * (l.ph - 1)));
         canvas.HLine(x - 4, x, y, dim);
         const PixelBox ink_box = font.InkBox(t.label, 9);
-        canvas.Text(font, t.label, 9, x - 6, std::clamp(y - (ink_box.y0 + ink_box.y1) / 2, y0 + 8, y0 + l.ph), dim,
-                    Align::kRight);
+        const int base = std::clamp(y - (ink_box.y0 + ink_box.y1) / 2, y0 + 8, y0 + l.ph);
+        const int left = x - 6 - font.Advance(t.label, 9);
+        if (Overlaps(Moved(ink_box, left, base), drawn)) continue;
+        drawn.push_back(canvas.Text(font, t.label, 9, left, base, dim));
       }
-      canvas.TextUp(font, s.y_axis.title, fit(s.y_axis.title, 10, l.ph), SheetLayout::kMargin + 10, y0 + l.ph / 2, dim);
+      const auto [title, px] = FitLine(font, s.y_axis.title, 10, l.ph);
+      canvas.TextUp(font, title, px, SheetLayout::kMargin + 10, y0 + l.ph / 2, dim);
     }
     if (!s.value_ticks.empty()) {
       SKYBAKE_CHECK_EQ(static_cast<int>(s.value_ticks.size()), l.rows);
@@ -436,21 +501,24 @@ std::string RenderPanelSheet(const PanelSheet& s, const Font& font) {
       bar.text_px = 9;
       bar.ink = dim;
       DrawScaleBar(canvas, font, bar);
-      canvas.TextUp(font, s.value_title, fit(s.value_title, 10, l.ph), l.width - SheetLayout::kMargin, y0 + l.ph / 2, dim);
+      const auto [title, px] = FitLine(font, s.value_title, 10, l.ph);
+      canvas.TextUp(font, title, px, l.width - SheetLayout::kMargin, y0 + l.ph / 2, dim);
     }
   }
   if (!s.x_axis.ticks.empty()) {  // under the bottom row
     const int y = l.PanelY(l.rows - 1) + l.ph;
     for (int c = 0; c < l.cols; ++c) {
       const int x0 = l.PanelX(c);
+      std::vector<PixelBox> drawn;
       for (const ScaleTick& t : s.x_axis.ticks) {
         const int x = x0 + static_cast<int>(std::lround(std::clamp(t.at, 0.0, 1.0) * (l.pw - 1)));
         canvas.VLine(x, y, y + 4, dim);
         const int adv = font.Advance(t.label, 9);
-        const int cx = std::clamp(x, x0 + adv / 2, x0 + l.pw - adv / 2);  // inside the panel's width
-        canvas.Text(font, t.label, 9, cx, y + 14, dim, Align::kCentre);
+        const int left = std::clamp(x - adv / 2, x0, x0 + l.pw - adv);  // inside the panel's width
+        if (Overlaps(Moved(font.InkBox(t.label, 9), left, y + 14), drawn)) continue;
+        drawn.push_back(canvas.Text(font, t.label, 9, left, y + 14, dim));
       }
-      canvas.Text(font, s.x_axis.title, fit(s.x_axis.title, 10, l.pw), x0 + l.pw / 2, y + 29, dim, Align::kCentre);
+      draw_fitted(s.x_axis.title, 10, l.pw + SheetLayout::kGap - 2, x0 + l.pw / 2, y + 29, dim, Align::kCentre);
     }
   }
   return canvas.EncodePng();

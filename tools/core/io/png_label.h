@@ -140,8 +140,11 @@ void DrawScaleBar(Canvas& canvas, const Font& font, const ScaleBar& scale);
 //                    title, under the bottom row's panels and left of the first column's
 //                    (no ticks: no axis);
 //   value_ticks      per row: the grey scale right of it (at: grey / 255), titled value_title.
-// Layout (px): margin 10, panels 8 apart; the sizes follow from the text and the panels
-// (PanelSheetSize).
+// Layout (px): margin 10; title lines word-wrapped to the sheet's width, 16 per line plus 6;
+// column headers 14 per line plus 4; a y axis 56 wide; panels 8 apart with a 16 px row label
+// above each row; the value scale 84 wide; the x axis 36 high. Headers and row labels that do
+// not fit shrink to 9 px and are then cut with "…"; tick labels that would touch one already
+// drawn are left out.
 struct PanelAxis {
   std::string title;
   std::vector<ScaleTick> ticks;
@@ -161,7 +164,7 @@ struct PanelSheet {
   std::string value_title;
 };
 // The PNG's width and height.
-std::pair<int, int> PanelSheetSize(const PanelSheet& sheet);
+std::pair<int, int> PanelSheetSize(const PanelSheet& sheet, const Font& font);
 std::string RenderPanelSheet(const PanelSheet& sheet, const Font& font);
 
 // Tick values for a linear axis over [lo, hi]: multiples of 1, 2 or 5 x 10^k, the finest step
