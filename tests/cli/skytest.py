@@ -67,6 +67,20 @@ def read_png(path):
     return width, height, channels, rows
 
 
+def panel_sheet(cols, rows, panel_w, panel_h, title_lines, header_lines):
+    """The layout of io/png_label.h RenderPanelSheet with both axes and the value scale (margin
+    10, y axis 56, panels 8 apart, a 16 px label above each row, value scale 84, x axis 36; title
+    6 + 16 per line, headers 4 + 14 per line): (width, height, origin(row, col) of a panel)."""
+    title_h, header_h = 6 + 16 * title_lines, 4 + 14 * header_lines
+    width = 2 * 10 + 56 + cols * panel_w + (cols - 1) * 8 + 84
+    height = 2 * 10 + title_h + header_h + rows * (16 + panel_h) + (rows - 1) * 8 + 36
+
+    def origin(r, c):
+        return 10 + 56 + c * (panel_w + 8), 10 + title_h + header_h + r * (16 + panel_h + 8) + 16
+
+    return width, height, origin
+
+
 def exr_attributes(path):
     """Reads the string attributes of an OpenEXR header (enough to check provenance) without
     any EXR library: magic, version, then (name, type, size, value) triples until a 0 byte."""
