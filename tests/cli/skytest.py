@@ -9,6 +9,7 @@ import struct
 import subprocess
 import tempfile
 import unittest
+import zlib
 
 BIN = os.environ.get("SKYBAKE_BIN_DIR", os.path.join(os.path.dirname(__file__), "..", "..", "build", "dev", "bin"))
 SRC = os.environ.get("SKYBAKE_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
@@ -24,6 +25,60 @@ def run(args, cwd=None, env=None, timeout=600):
     if env:
         e.update(env)
     return subprocess.run(args, cwd=cwd, env=e, capture_output=True, text=True, timeout=timeout)
+
+
+def read_png(path):
+    """Decodes an 8-bit, non-interlaced PNG (grey, RGB or RGBA) with zlib and struct, by the PNG
+    specification (ISO/IEC 15948, section 9: the five row filters). Returns (width, height,
+    channels, rows) with rows a list of bytes objects, top to bottom."""
+    with open(path, "rb") as f:
+        data = f.read()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", "not a PNG"
+    pos, idat, header = 8, b"", None
+    while pos < len(data):
+        (length,) = struct.unpack(">I", data[pos:pos + 4])
+        kind, body = data[pos + 4:pos + 8], data[pos + 8:pos + 8 + length]
+        if kind == b"IHDR":
+            header = struct.unpack(">IIBBBBB", body)
+        elif kind == b"IDAT":
+            idat += body
+        pos += 12 + length
+    width, height, depth, colour, _, _, interlace = header
+    assert depth == 8 and interlace == 0, "only 8-bit non-interlaced PNGs"
+    channels = {0: 1, 2: 3, 6: 4}[colour]
+    raw, stride, rows, prev = zlib.decompress(idat), width * channels, [], bytearray(width * channels)
+    for y in range(height):
+        kind, line = raw[y * (stride + 1)], bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            a = line[i - channels] if i >= channels else 0
+            b, c = prev[i], prev[i - channels] if i >= channels else 0
+            if kind == 1:
+                line[i] = (line[i] + a) & 255
+            elif kind == 2:
+                line[i] = (line[i] + b) & 255
+            elif kind == 3:
+                line[i] = (line[i] + (a + b) // 2) & 255
+            elif kind == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
+        rows.append(bytes(line))
+        prev = line
+    return width, height, channels, rows
+
+
+def panel_sheet(cols, rows, panel_w, panel_h, title_lines, header_lines):
+    """The layout of io/png_label.h RenderPanelSheet with both axes and the value scale (margin
+    10, y axis 56, panels 8 apart, a 16 px label above each row, value scale 84, x axis 36; title
+    6 + 16 per line, headers 4 + 14 per line): (width, height, origin(row, col) of a panel)."""
+    title_h, header_h = 6 + 16 * title_lines, 4 + 14 * header_lines
+    width = 2 * 10 + 56 + cols * panel_w + (cols - 1) * 8 + 84
+    height = 2 * 10 + title_h + header_h + rows * (16 + panel_h) + (rows - 1) * 8 + 36
+
+    def origin(r, c):
+        return 10 + 56 + c * (panel_w + 8), 10 + title_h + header_h + r * (16 + panel_h + 8) + 16
+
+    return width, height, origin
 
 
 def exr_attributes(path):

@@ -5,7 +5,7 @@ import os
 import struct
 import unittest
 
-from skytest import SRC, CliContract, TempDirTestCase, run, tool
+from skytest import SRC, CliContract, TempDirTestCase, panel_sheet, read_png, run, tool
 from test_noise_gen import ktx_level, ktx_parse, png_size, read_bytes
 
 CUMULUS = os.path.join(SRC, "clouds", "cumulus.yaml")
@@ -45,7 +45,15 @@ class CumulusMapCli(CliContract, TempDirTestCase):
         self.assertGreater(cloudy, 0.1)
         self.assertLess(cloudy, 0.9)
         self.assertGreater(max(ctype) - min(ctype), 100)
-        self.assertEqual(png_size(self.path("map.png")), (2 * 256 + 4, 256))
+        # The labelled preview: density and type panels of 256 x 256, north up (row y = texel row 255 - y).
+        w, h, origin = panel_sheet(2, 1, 256, 256, 2, 2)
+        pw, ph, _, rows = read_png(self.path("map.png"))
+        self.assertEqual((pw, ph), (w, h))
+        for p in range(2):
+            x0, y0 = origin(0, p)
+            for j in range(0, 256, 7):
+                for i in range(0, 256, 5):
+                    self.assertEqual(rows[y0 + 255 - j][3 * (x0 + i)], level[(j * 256 + i) * 2 + p], (p, i, j))
         oiio = run(["oiiotool", "--info", "-v", self.path("map.exr")])
         self.assertEqual(oiio.returncode, 0, oiio.stderr)
         self.assertIn("256 x  256", oiio.stdout)
@@ -107,7 +115,16 @@ class CumulusMapCli(CliContract, TempDirTestCase):
         # Congestus at full density reaches 7 km: row of 7 km = (7 - 0.5) / 8 * 127 = 103.2.
         top = max(j for j in range(128) if texel(2, 255, j, 0) > 0)
         self.assertEqual(top, 103)
-        self.assertEqual(png_size(self.path("c.png")), (4 * 256 + 12, 3 * 128 + 8))
+        # One row of 4 channel panels (256 x 128, altitude up) per cloud type; 1-line headers.
+        w, h, origin = panel_sheet(4, 3, 256, 128, 2, 1)
+        pw, ph, _, rows = read_png(self.path("c.png"))
+        self.assertEqual((pw, ph), (w, h))
+        for layer in range(3):
+            for c in range(4):
+                x0, y0 = origin(layer, c)
+                for j in range(0, 128, 9):
+                    for i in range(0, 256, 11):
+                        self.assertEqual(rows[y0 + 127 - j][3 * (x0 + i)], texel(layer, i, j, c), (layer, c, i, j))
 
     def test_same_bytes_at_any_thread_count(self):
         for product, src in (("map", CUMULUS), ("coverage", COVERAGE)):

@@ -14,7 +14,7 @@ import struct
 import tempfile
 import unittest
 
-from skytest import exr_attributes, SRC, CliContract, TempDirTestCase, run, tool
+from skytest import SRC, CliContract, TempDirTestCase, exr_attributes, read_png, run, tool
 from test_noise_gen import ktx_level, ktx_parse
 
 CLEAR = os.path.join(SRC, "atmospheres", "clear.yaml")
@@ -156,6 +156,56 @@ class LutPackCli(CliContract, TempDirTestCase):
         self.assertEqual(report["time_mapping"]["name"], "gt7:3+2")
         self.assertEqual(report["files_bytes"]["sky_sunny.dds"], os.path.getsize(self.path("sky_sunny.dds")))
 
+    def test_contact_sheet_shows_each_sky_at_each_sun_elevation(self):
+        # Layout (lut/contact_sheet.h): 998 px wide (a label column and 5 cells of 160 px, 16 px
+        # apart), 2 x 12 + 84 + 76 + rows x 168 - 8 px high.
+        self.assertEqual(self.pack(self.path("two")).returncode, 0)
+        three = self.pack(self.path("three"), skies=["sunny=" + self.sky_a, "cloudy=" + self.sky_b, "again=" + self.sky_a])
+        self.assertEqual(three.returncode, 0, three.stderr)
+        w, h, channels, rows = read_png(self.path("two", "contact_sheet.png"))
+        self.assertEqual((w, h, channels), (998, 24 + 84 + 76 + 2 * 168 - 8, 3))
+        w3, h3, _, rows3 = read_png(self.path("three", "contact_sheet.png"))
+        self.assertEqual((w3, h3), (998, h + 168))  # one more row of cells
+
+        def cell(rows, r, c):
+            """The pixels of the inner disc (radius 60 of the 80 px fisheye) of row r, column c."""
+            x0, y0 = 12 + 110 + c * 176, 12 + 84 + 76 + r * 168
+            out = []
+            for y in range(y0 + 20, y0 + 140):
+                for x in range(x0 + 20, x0 + 140):
+                    if (x - x0 - 80) ** 2 + (y - y0 - 80) ** 2 <= 60 ** 2:
+                        out.append(tuple(rows[y][3 * x:3 * x + 3]))
+            return out
+
+        for r in range(2):
+            day, twilight = cell(rows, r, 0), cell(rows, r, 4)  # sun 60 and -4 deg
+            mean = [sum(p[k] for p in day) / len(day) for k in range(3)]
+            self.assertGreater(sum(mean) / 3, 40, "the day sky is not dark")
+            self.assertGreater(mean[2], mean[0], "the day sky is blue")
+            self.assertGreater(len(set(day)), 20, "the day sky is not uniform")
+            self.assertGreater(len(set(twilight)), 20, "the twilight sky is not uniform")
+            diff = sum(abs(a - b) for p, q in zip(day, twilight) for a, b in zip(p, q)) / (3 * len(day))
+            self.assertGreater(diff, 10, "sun 60 and -4 deg look alike")
+        # The same sky in a third row is drawn alike: the rows are the skies, nothing else.
+        self.assertEqual(cell(rows3, 2, 1), cell(rows3, 0, 1))
+        # The exposure is per column, shared by the skies in it: the 4x8 and the 2x4 LUT of the same
+        # atmosphere at sun 20 deg are within a few codes of each other on average.
+        a, b = cell(rows, 0, 1), cell(rows, 1, 1)
+        self.assertLess(abs(sum(map(sum, a)) / len(a) - sum(map(sum, b)) / len(b)), 3 * 40)
+        # The title, headers and scales are drawn: text-coloured pixels above the cells.
+        header = rows[12:12 + 84 + 76]
+        self.assertGreater(sum(1 for row in header for x in range(0, 3 * w, 3) if row[x] > 200), 500)
+
+    def test_missing_font_is_bad_input_and_writes_nothing(self):
+        font = self.path("none", "NoSuchFont.ttf")
+        r = run([tool("lut-pack"), "pack", "sunny=" + self.sky_a, "-o", self.path("report.json")],
+                env={"SKYBAKE_FONT": font})
+        self.assertEqual(r.returncode, 1, r.stderr)
+        self.assertEqual(r.stderr.strip(), "lut-pack: %s: font file not found (the labels of the PNG pictures need a "
+                                           "TrueType font: install Debian fonts-dejavu-core, e.g. with scripts/setup, or "
+                                           "name one with SKYBAKE_FONT)" % font)
+        self.assertEqual(os.listdir(self.tmp), [])
+
     def test_same_bytes_at_any_thread_count(self):
         outs = {}
         for threads in ("1", "2"):
@@ -166,6 +216,7 @@ class LutPackCli(CliContract, TempDirTestCase):
             outs[threads] = {f: open(os.path.join(d, f), "rb").read() for f in sorted(os.listdir(d))}
         self.assertEqual(outs["1"], outs["2"])
         self.assertGreater(len(outs["1"]), 10)
+        self.assertIn("contact_sheet.png", outs["1"])
 
     def test_a_render_on_another_mapping_is_bad_input_and_writes_nothing(self):
         r = self.pack(self.tmp, skies=["sunny=" + self.sky_a, "flat=" + self.equirect])

@@ -12,7 +12,7 @@ import struct
 import subprocess
 import unittest
 
-from skytest import SRC, CliContract, TempDirTestCase, run, tool
+from skytest import SRC, CliContract, TempDirTestCase, panel_sheet, read_png, run, tool
 
 KTX_PARSE_DIR = os.path.join(SRC, ".tools", "node_modules", "ktx-parse")
 LOW = os.path.join(SRC, "clouds", "noise_low.yaml")
@@ -128,11 +128,13 @@ class NoiseGenCli(CliContract, TempDirTestCase):
         self.assertGreaterEqual(min(values), -1.0)
         self.assertLessEqual(max(values), 1.0)
         self.assertEqual(max(-min(values), max(values)), 1.0)
-        # The EXR (OpenImageIO) and the PNG montage (4 slices of 2 x 128 pixels, 4 px gaps).
+        # The EXR (OpenImageIO) and the labelled PNG montage: 4 slices of 2 x 128 pixels, 3 title lines,
+        # 2-line column headers.
         oiio = run(["oiiotool", "--info", "-v", self.path("low.exr")])
         self.assertEqual(oiio.returncode, 0, oiio.stderr)
         self.assertIn("128 x 16384", oiio.stdout)
-        self.assertEqual(png_size(self.path("low.png")), (4 * 256 + 3 * 4, 256))
+        w, h, _ = panel_sheet(4, 1, 256, 256, 3, 2)
+        self.assertEqual(png_size(self.path("low.png")), (w, h))
         with open(out + ".d") as f:
             self.assertIn("noise_low.yaml", f.read())
 
@@ -155,7 +157,36 @@ class NoiseGenCli(CliContract, TempDirTestCase):
         self.assertEqual([s["channelType"] for s in info["dfd"]["samples"]], [0, 1, 2, 15])
         self.assertEqual([s["bitOffset"] for s in info["dfd"]["samples"]], [0, 8, 16, 24])
         self.assertEqual(info["levels"][0]["byteLength"], 16 ** 3 * 4)
-        self.assertEqual(png_size(self.path("rgba.png")), (4 * 32 + 3 * 4, 4 * 32 + 3 * 4))
+        level = ktx_level(out, info)
+        # 4 channels x 4 slices of 2 x 16 texels, drawn 2 x 2 pixels per texel (N < 64).
+        # The 3 title lines wrap to the 440 px width: the height grows by 16 px per extra line.
+        pw, ph, channels, rows = read_png(self.path("rgba.png"))
+        w, h, _ = panel_sheet(4, 4, 64, 64, 3, 2)
+        self.assertEqual((pw, channels), (w, 3))
+        self.assertEqual((ph - h) % 16, 0)
+        self.assertGreater(ph, h)
+        w, h, origin = panel_sheet(4, 4, 64, 64, 3 + (ph - h) // 16, 2)
+        # Each panel is its slice's texels (min_max: value = code / 255), tiled 2 x 2; slice k = N/4 = 4.
+        for c in range(4):
+            x0, y0 = origin(c, 1)
+            for j in range(32):
+                for i in range(32):
+                    code = level[((4 * 16 + j % 16) * 16 + i % 16) * 4 + c]
+                    grey = rows[y0 + 2 * j][3 * (x0 + 2 * i)]
+                    self.assertLessEqual(abs(grey - code), 1, (c, i, j))
+        # Labels: text-coloured pixels in the title and headers, and left of the panels (y axis).
+        self.assertGreater(sum(1 for row in rows[:origin(0, 0)[1]] for x in range(0, 3 * w, 3) if row[x] > 200), 100)
+        self.assertGreater(sum(1 for row in rows for x in range(0, 3 * (origin(0, 0)[0] - 2), 3) if row[x] > 150), 50)
+
+    def test_the_preview_needs_the_font_and_nothing_else_does(self):
+        font = self.path("none", "NoSuchFont.ttf")
+        out = self.path("high.ktx2")
+        r = run([tool("noise-gen"), HIGH, "-o", out, "--preview", self.path("high.png")], env={"SKYBAKE_FONT": font})
+        self.assertEqual(r.returncode, 1, r.stderr)
+        self.assertTrue(r.stderr.startswith("noise-gen: %s: font file not found" % font), r.stderr)
+        self.assertEqual(os.listdir(self.tmp), [])
+        r = run([tool("noise-gen"), HIGH, "-o", out], env={"SKYBAKE_FONT": font})
+        self.assertEqual(r.returncode, 0, r.stderr)
 
     def test_same_bytes_at_any_thread_count(self):
         outs = {}

@@ -159,8 +159,11 @@ class LutPipelineTest(PipelineTestCase):
             self.assertIn("sky-render %s/lut_sky.exr" % atm, ran)
         self.assertIn("lut-pack luts/report.json", ran)
         self.assertEqual(ran.count("lut-pack luts/report.json"), 1)
-        for f in TEXTURES + ["sky_clear_array.ktx2", "sky_clear.dds", "sky_clear.exr", "other_luts.exr", "report.json"]:
+        for f in TEXTURES + ["sky_clear_array.ktx2", "sky_clear.dds", "sky_clear.exr", "other_luts.exr", "contact_sheet.png",
+                             "report.json"]:
             self.assertTrue(os.path.isfile(os.path.join(self.out, "luts", f)), f)
+        # The contact sheet is an output of the pack edge (ninja knows who makes it).
+        self.assertIn("lut_pack", self.ninja("-t", "query", "luts/contact_sheet.png").stdout)
         self.assertIn("no work to do", self.ninja("-n").stdout)
         self.assertIn("No missing dependencies", self.ninja("-t", "missingdeps").stdout)
 

@@ -24,15 +24,13 @@ import math
 import os
 import re
 import shutil
-import struct
 import subprocess
 import sys
 import unittest
-import zlib
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "cli"))
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "pipeline"))
-from skytest import SRC, TempDirTestCase, run, tool  # noqa: E402
+from skytest import SRC, TempDirTestCase, read_png, run, tool  # noqa: E402
 from test_lut_pipeline import TINY_PARTICLE  # noqa: E402
 
 PIPELINE = """outputs: outputs
@@ -131,46 +129,9 @@ def dump_exr(path):
 
 
 def png_pixels(path):
-    """(width, height, channels, bytes) of an 8-bit, non-interlaced PNG (zlib + struct)."""
-    with open(path, "rb") as f:
-        data = f.read()
-    assert data[:8] == b"\x89PNG\r\n\x1a\n", path
-    pos, idat, w = 8, b"", None
-    while pos < len(data):
-        (n,) = struct.unpack(">I", data[pos:pos + 4])
-        kind = data[pos + 4:pos + 8]
-        body = data[pos + 8:pos + 8 + n]
-        if kind == b"IHDR":
-            w, h, depth, colour, _, _, interlace = struct.unpack(">IIBBBBB", body)
-            assert depth == 8 and interlace == 0, path
-            ch = {0: 1, 2: 3, 4: 2, 6: 4}[colour]
-        elif kind == b"IDAT":
-            idat += body
-        pos += 12 + n
-    raw = zlib.decompress(idat)
-    stride = w * ch
-    out = bytearray()
-    prev = bytearray(stride)
-    for y in range(h):
-        f = raw[y * (stride + 1)]
-        line = bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
-        for i in range(stride):
-            a = line[i - ch] if i >= ch else 0
-            b = prev[i]
-            c = prev[i - ch] if i >= ch else 0
-            if f == 1:
-                line[i] = (line[i] + a) & 255
-            elif f == 2:
-                line[i] = (line[i] + b) & 255
-            elif f == 3:
-                line[i] = (line[i] + (a + b) // 2) & 255
-            elif f == 4:
-                p = a + b - c
-                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
-                line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
-        out += line
-        prev = line
-    return w, h, ch, bytes(out)
+    """(width, height, channels, bytes) of an 8-bit PNG (skytest.read_png, zlib + struct)."""
+    w, h, ch, rows = read_png(path)
+    return w, h, ch, b"".join(rows)
 
 
 def dome_direction(x, y, w, h):

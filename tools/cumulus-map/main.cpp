@@ -14,10 +14,11 @@
 #include "io/error.h"
 #include "io/exr.h"
 #include "io/fileio.h"
-#include "io/png.h"
+#include "io/png_label.h"
 #include "lut/ktx2.h"
 #include "noise/coverage.h"
 #include "noise/cumulus.h"
+#include "preview.h"
 
 namespace fs = std::filesystem;
 using namespace skybake;
@@ -30,20 +31,7 @@ struct Encoded {
   std::string summary;
 };
 
-// Grey panels side by side, `gap` mid-grey pixels apart; panel p pixel (x, y) = value(p, x, y)
-// in [0, 1].
-template <typename F>
-std::string Panels(int panels, int w, int h, F value) {
-  constexpr int kGap = 4;
-  const int width = panels * w + (panels - 1) * kGap;
-  std::vector<uint8_t> px(static_cast<size_t>(width) * h, 128);
-  for (int p = 0; p < panels; ++p)
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) px[static_cast<size_t>(y) * width + p * (w + kGap) + x] = ktx2::FloatToUnorm8(value(p, x, y));
-  return EncodePng8(width, h, 1, px);
-}
-
-Encoded MapProduct(ToolCli& cli, const std::string& input, std::optional<double> time_override) {
+Encoded MapProduct(ToolCli& cli, const std::string& input, std::optional<double> time_override, const Font* font) {
   CumulusSpec spec = LoadCumulusSpec(input);
   if (time_override) spec.time_s = *time_override;
   const WeatherField field(spec.weather);
@@ -91,13 +79,12 @@ Encoded MapProduct(ToolCli& cli, const std::string& input, std::optional<double>
   image.doubles["skybake.texel_size_m.centre"] = m.TexelSizeM(0.0);
   image.doubles["skybake.texel_size_m.edge"] = m.TexelSizeM(1.0);
   e.exr = EncodeExr(image);
-  // North up: preview row y shows texel row n - 1 - y.
-  e.png = Panels(2, n, n, [&](int p, int x, int y) { return map.At(x, n - 1 - y, p); });
+  if (font) e.png = RenderPanelSheet(CumulusMapPreview(spec, map, fs::path(input).filename().string()), *font);
   e.summary = fmt::format("{}x{} R8G8_UNORM at t = {} s", n, n, FormatExact(spec.time_s));
   return e;
 }
 
-Encoded CoverageProduct(ToolCli& cli, const std::string& input) {
+Encoded CoverageProduct(ToolCli& cli, const std::string& input, const Font* font) {
   const CoverageSpec spec = LoadCoverageSpec(input);
   const CoverageTexture t = BuildCoverageTexture(spec);
 
@@ -140,17 +127,7 @@ Encoded CoverageProduct(ToolCli& cli, const std::string& input) {
   ExrImage image = TableToImage(table);
   SetProvenance(image, prov);
   e.exr = EncodeExr(image);
-  // One row of four channel panels per type (altitude up), stacked vertically.
-  const int panel_h = t.height, gap = 4;
-  const int width = 4 * t.width + 3 * gap, height = t.layers * panel_h + (t.layers - 1) * gap;
-  std::vector<uint8_t> px(static_cast<size_t>(width) * height, 128);
-  for (int k = 0; k < t.layers; ++k)
-    for (int c = 0; c < 4; ++c)
-      for (int y = 0; y < panel_h; ++y)
-        for (int x = 0; x < t.width; ++x)
-          px[static_cast<size_t>(k * (panel_h + gap) + y) * width + c * (t.width + gap) + x] =
-              ktx2::FloatToUnorm8(t.At(k, x, t.height - 1 - y, c));
-  e.png = EncodePng8(width, height, 1, px);
+  if (font) e.png = RenderPanelSheet(CoveragePreview(spec, t, fs::path(input).filename().string()), *font);
   e.summary = fmt::format("{}x{} x{} layers R8G8B8A8_UNORM ({})", t.width, t.height, t.layers, layers);
   return e;
 }
@@ -174,11 +151,18 @@ int main(int argc, char** argv) {
   return cli.Run(argc, argv, [&] {
     if (product == "coverage" && time_s) throw UsageError("--time-s applies to --product map only");
     // Load, validate, compute and encode every output in memory; write only when all succeeded.
-    const Encoded e = product == "map" ? MapProduct(cli, input, time_s) : CoverageProduct(cli, input);
+    std::optional<Font> font;  // the preview's labels; missing: exit 1 before any output
+    if (!preview_path.empty()) font = Font::Load();
+    const Font* f = font ? &*font : nullptr;
+    const Encoded e = product == "map" ? MapProduct(cli, input, time_s, f) : CoverageProduct(cli, input, f);
     bool changed = WriteFileIfChanged(output, e.ktx);
     if (!exr_path.empty()) changed |= WriteFileIfChanged(exr_path, e.exr);
     if (!preview_path.empty()) changed |= WriteFileIfChanged(preview_path, e.png);
-    if (!depfile.empty()) WriteDepfile(depfile, output, {input});
+    if (!depfile.empty()) {
+      std::vector<fs::path> deps = {input};
+      if (font) deps.push_back(font->path());
+      WriteDepfile(depfile, output, deps);
+    }
     cli.Info(fmt::format("{} {} ({})", changed ? "wrote" : "unchanged", output, e.summary));
   });
 }

@@ -115,6 +115,7 @@ int main(int argc, char** argv) {
       if (name.empty()) name = render.atmosphere;
       if (!IsName(name)) throw UsageError("--name: expected a lowercase identifier (a-z, 0-9, _), got '" + name + "'");
       const ColorConfig config = ColorConfig::Load(ocio_config);
+      const Font font = Font::Load();  // the residual PNG's labels; missing: exit 1 before any output
       std::vector<fs::path> files_read = {input, config.path()};
 
       const fog::FogProducts products = fog::BuildFogProducts(render, name, o, config, &files_read);
@@ -126,14 +127,18 @@ int main(int argc, char** argv) {
       prov.parameters = fmt::format("subcommand: fit\nname: {}\nangle: {}\nchannels: {}\nparams: {}\nfit_sun_zenith_deg: [{}]\nfit_elevation_stride: {}\nprefix: {}\n",
                                     name, angle, channels, params_mode, fit_list, fit_elevation_stride, prefix);
       for (const fs::path& f : files_read) prov.AddInput(f);
-      const std::map<std::string, std::string> files = fog::EncodeFogProducts(render, products, prefix, prov);
+      const std::map<std::string, std::string> files = fog::EncodeFogProducts(render, products, prefix, prov, font);
       const fs::path dir = fs::path(output).parent_path();
       int changed = 0;
       for (const auto& [f, bytes] : files) {
         if (f != file) changed += WriteFileIfChanged(dir / f, bytes) ? 1 : 0;
       }
       changed += WriteFileIfChanged(output, files.at(file)) ? 1 : 0;  // the edge's output last
-      if (!depfile.empty()) WriteDepfile(depfile, output, files_read);
+      if (!depfile.empty()) {
+        std::vector<fs::path> deps = files_read;
+        deps.push_back(font.path());  // not in the provenance: only the residual PNG depends on it
+        WriteDepfile(depfile, output, deps);
+      }
       const fog::ProductStats& s = products.fog_eval;
       cli.Info(fmt::format("{}: fog ({} parameters) a = {:.4g} {:.4g} {:.4g}, p = {:.4g} {:.4g} {:.4g} (global fit); evaluator error RMS {:.2f} % "
                            "(max {:.1f} %), near the camera {:.2f} % (max {:.1f} %), horizon {:.2f} % (max {:.1f} %); "

@@ -5,7 +5,7 @@
 //            [--night-end-zenith-deg 108] [--ocio-config config.ocio] [--depfile OUT/report.json.d]
 //       SKY.exr: sky-render render --mapping gt7 --time-mapping gt7 --size WxH (one per basis sky);
 //       writes OUT/sky_<NAME>.{ktx2,_array.ktx2,dds,exr}, OUT/{transmittance,sun,ambient}.{ktx2,dds},
-//       OUT/other_luts.exr and the report.
+//       OUT/other_luts.exr, OUT/contact_sheet.png and the report.
 //   lut-pack check LUT.ktx2[:WEIGHT] ... --direct DIRECT.exr -o check.json [--sun-cone-deg 5]
 //       decodes the LUT (or the weighted blend of several) at the direct render's sun angles and
 //       directions and reports the luminance error.
@@ -28,6 +28,7 @@
 #include "io/error.h"
 #include "io/fileio.h"
 #include "io/png.h"
+#include "io/png_label.h"
 #include "io/yaml.h"
 #include "lut/check.h"
 #include "lut/decoder.h"
@@ -205,6 +206,7 @@ int main(int argc, char** argv) {
       renders.reserve(named.size());
       for (const auto& [name, path] : named) renders.push_back(lut::ReadSkyRender(path));
       const ColorConfig config = ColorConfig::Load(ocio_config);
+      const Font font = Font::Load();  // the contact sheet's labels; missing: exit 1 before any output
       std::vector<fs::path> files_read;
       for (const auto& [name, path] : named) files_read.push_back(path);
       files_read.push_back(config.path());
@@ -256,7 +258,7 @@ int main(int argc, char** argv) {
         sp.AddInput(path);
         for (size_t i = named.size(); i < files_read.size(); ++i) sp.AddInput(files_read[i]);  // OCIO config, CMFs
       }
-      std::map<std::string, std::string> files = luttool::EncodeLutSet(set, prov, sky_prov);
+      std::map<std::string, std::string> files = luttool::EncodeLutSet(set, prov, sky_prov, config, font);
       files["display.json"] = luttool::DisplayShaderJson(config);
       luttool::ReportContext ctx;
       for (const auto& [name, bytes] : files) ctx.file_bytes[name] = bytes.size();
@@ -268,7 +270,11 @@ int main(int argc, char** argv) {
       int changed = 0;
       for (const auto& [name, bytes] : files) changed += WriteFileIfChanged(dir / name, bytes) ? 1 : 0;
       changed += WriteFileIfChanged(output, report) ? 1 : 0;
-      if (!depfile.empty()) WriteDepfile(depfile, output, files_read);
+      if (!depfile.empty()) {
+        std::vector<fs::path> deps = files_read;
+        deps.push_back(font.path());  // not in the provenance: only the contact sheet depends on it
+        WriteDepfile(depfile, output, deps);
+      }
       cli.Info(fmt::format("{} skies, {} bytes of sky LUTs ({:.3f} MiB); {} of {} files changed", set.skies.size(), sky_bytes,
                            sky_bytes / (1024.0 * 1024.0), changed, files.size() + 1));
       return;

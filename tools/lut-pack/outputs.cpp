@@ -7,7 +7,9 @@
 #include "color/color.h"
 #include "color/exr_color.h"
 #include "io/yaml.h"
+#include "lut/contact_sheet.h"
 #include "lut/dds.h"
+#include "lut/decoder.h"
 
 namespace skybake::luttool {
 
@@ -81,12 +83,17 @@ std::string DisplayShaderJson(const ColorConfig& config) {
 }
 
 std::map<std::string, std::string> EncodeLutSet(const lut::LutSet& set, const Provenance& prov,
-                                                const std::map<std::string, Provenance>& sky_prov) {
+                                                const std::map<std::string, Provenance>& sky_prov, const ColorConfig& config,
+                                                const Font& font) {
   std::map<std::string, std::string> out;
+  std::vector<lut::SkyLutDecoder> decoders;  // of the packed 3D textures, for the contact sheet
+  decoders.reserve(set.skies.size());
   for (const lut::SkyLutProduct& s : set.skies) {
     const Provenance& sp = sky_prov.at(s.name);
     const std::string base = "sky_" + s.name;
-    out[base + ".ktx2"] = ktx2::EncodeKtx2(lut::SkyKtx2(set, s, false, sp));
+    const ktx2::Texture volume = lut::SkyKtx2(set, s, false, sp);
+    out[base + ".ktx2"] = ktx2::EncodeKtx2(volume);
+    decoders.push_back(lut::SkyLutDecoder::FromKtx2(volume, base + ".ktx2"));
     out[base + "_array.ktx2"] = ktx2::EncodeKtx2(lut::SkyKtx2(set, s, true, sp));
     out[base + ".dds"] = dds::EncodeDds(Dds(s.sky, true));
     ExrImage img = InspectionImage(s.sky.width, s.sky.height * s.sky.depth, s.sky, sp);
@@ -124,6 +131,9 @@ std::map<std::string, std::string> EncodeLutSet(const lut::LutSet& set, const Pr
     parts.push_back({o.name, std::move(img)});
   }
   out["other_luts.exr"] = EncodeExrParts(parts);
+  std::vector<lut::ContactSheetSky> sheet;
+  for (size_t i = 0; i < set.skies.size(); ++i) sheet.push_back({set.skies[i].name, &decoders[i]});
+  out["contact_sheet.png"] = lut::RenderContactSheet(sheet, set.skies[0].render->time_mapping_name, config, font).png;
   return out;
 }
 

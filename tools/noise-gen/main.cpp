@@ -5,13 +5,14 @@
 //   noise-gen VOLUME.yaml -o VOLUME.ktx2 [--exr VOLUME.exr] [--preview VOLUME.png]
 //             [--depfile VOLUME.ktx2.d]
 #include <filesystem>
+#include <optional>
 
 #include <fmt/format.h>
 
 #include "io/cli.h"
 #include "io/exr.h"
 #include "io/fileio.h"
-#include "io/png.h"
+#include "io/png_label.h"
 #include "lut/ktx2.h"
 #include "noise/volume.h"
 #include "preview.h"
@@ -68,6 +69,8 @@ int main(int argc, char** argv) {
   return cli.Run(argc, argv, [&] {
     // Load and validate.
     const VolumeSpec spec = LoadVolumeSpec(input);
+    std::optional<Font> font;  // the preview's labels; missing: exit 1 before any output
+    if (!preview_path.empty()) font = Font::Load();
     // One core call.
     const GeneratedVolume g = GenerateVolume(spec, cli.Progress());
     const Volume& v = g.volume;
@@ -131,15 +134,25 @@ int main(int argc, char** argv) {
 
     std::string png_bytes;
     if (!preview_path.empty()) {
-      const Montage m = VolumeMontage(v, g.range);
-      png_bytes = EncodePng8(m.width, m.height, 1, m.pixels);
+      std::vector<std::string> labels;
+      for (int c = 0; c < v.channels; ++c) labels.push_back(std::string(kChannelNames[c]) + ": " + Describe(spec.channels[c]));
+      const std::vector<std::string> title = {
+          fmt::format("noise-gen {}: {}\u00b3 texels, {}, tile {} m, normalisation {}", fs::path(input).filename().string(), n,
+                      tex.format.name, FormatExact(spec.tile_size_m), NormalizationName(spec.normalization)),
+          "Four z slices per channel (columns), each repeated 2 \u00d7 2 so that a seam would show as a line through the middle.",
+          "Grey = the channel's value (scale at the right of each row)."};
+      png_bytes = RenderPanelSheet(VolumeMontage(v, g.range, title, labels, spec.tile_size_m), *font);
     }
 
     // Write.
     bool changed = WriteFileIfChanged(output, ktx_bytes);
     if (!exr_path.empty()) changed |= WriteFileIfChanged(exr_path, exr_bytes);
     if (!preview_path.empty()) changed |= WriteFileIfChanged(preview_path, png_bytes);
-    if (!depfile.empty()) WriteDepfile(depfile, output, {input});
+    if (!depfile.empty()) {
+      std::vector<fs::path> deps = {input};
+      if (font) deps.push_back(font->path());
+      WriteDepfile(depfile, output, deps);
+    }
     cli.Info(fmt::format("{} {} ({}^3 {}, {} channel{})", changed ? "wrote" : "unchanged", output, n, tex.format.name,
                          v.channels, v.channels == 1 ? "" : "s"));
   });

@@ -37,7 +37,7 @@ inline std::vector<std::string> LutSkyFiles(const std::string& sky) {
 }
 inline std::vector<std::string> LutSetFiles() {
   return {"transmittance.ktx2", "transmittance.dds", "sun.ktx2", "sun.dds", "ambient.ktx2", "ambient.dds", "other_luts.exr",
-          "display.json"};
+          "display.json", "contact_sheet.png"};
 }
 
 // outputs/<atm>/fog.exr: sky-render fog (the reference fog of the low atmosphere) for fog-fit.

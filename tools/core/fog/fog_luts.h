@@ -25,6 +25,7 @@
 #include "fog/fog_fit.h"
 #include "fog/fog_render.h"
 #include "io/exr.h"
+#include "io/png_label.h"
 #include "lut/sky_lut.h"
 
 namespace skybake::fog {
@@ -117,9 +118,10 @@ FogEvaluator MakeEvaluator(const FogProducts& products);
 //   P_attenuation.ktx2, P_attenuation.dds             attenuation LUT (2D)
 //   P.exr                   inspection (the three textures decoded, inputs, clamp flags)
 //   P_report.json           residual statistics, fit status, packing
-//   P_residuals.exr, P_residuals.png                  residual maps
+//   P_residuals.exr, P_residuals.png                  residual maps (the PNG labelled with `font`)
 std::map<std::string, std::string> EncodeFogProducts(const FogRender& render, const FogProducts& products,
-                                                     const std::string& prefix, const Provenance& provenance);
+                                                     const std::string& prefix, const Provenance& provenance,
+                                                     const Font& font);
 std::vector<std::string> FogProductFiles(const std::string& prefix);
 
 }  // namespace skybake::fog
