@@ -149,9 +149,9 @@ export function weatherWeights(bake, h, c) {
 // ------------------------------------------------------------------------------------- app
 
 class Viewer {
-  constructor(canvas, bake, sources) {
+  constructor(canvas, gl, bake, sources) {
     this.canvas = canvas;
-    this.gl = canvas.getContext("webgl2", { antialias: false, preserveDrawingBuffer: true });
+    this.gl = gl;
     this.bake = bake;
     this.sources = sources;
   }
@@ -164,7 +164,7 @@ class Viewer {
     const names = ["skybake_runtime.glsl", "common.glsl", "fullscreen.vert", "dome.frag", "fogpoints.frag", "scene.frag", "display.frag"];
     const src = {};
     for (const n of names) src[n] = await text(`glsl/${n}`);
-    const v = new Viewer(canvas, bake, src);
+    const v = new Viewer(canvas, gl, bake, src);
     v.build();
     return v;
   }
