@@ -106,6 +106,61 @@ class SkyRenderCli(CliContract, TempDirTestCase):
         self.assertEqual(r.returncode, 1)
         self.assertEqual(r.stderr, "sky-render: %s:4: column 'view_zenith_deg': expected a number, got \"x\"\n" % geom)
 
+    def points(self, geom_text, *extra, out="out.csv"):
+        atm = rayleigh_atmosphere(self.tmp)
+        geom = self.write("g.csv", geom_text)
+        return run([tool("sky-render"), "points", atm, "--geometry", geom, "-o", self.path(out), "--wavelengths",
+                    "400:700:20", "--wavelengths-out", "440,560,680", "--quiet"] + list(extra)), geom
+
+    def read_points(self, name="out.csv"):
+        with open(self.path(name)) as f:
+            lines = [l for l in f.read().splitlines() if not l.startswith("#")]
+        header = lines[0].split(",")
+        return [dict(zip(header, l.split(","))) for l in lines[1:]]
+
+    GEOM = ("# source: test geometries\nsun_zenith_deg,view_zenith_deg,relative_azimuth_deg,observer_altitude_km\n"
+            "30,0,0,0\n60,80,30,0\n60,80,30,2\n")
+
+    def test_points_every_column_has_its_error_and_the_bytes_do_not_depend_on_threads(self):
+        for threads, out in (("1", "a.csv"), ("2", "b.csv")):
+            r, _ = self.points(self.GEOM, "--target-error", "0.05", "--threads", threads, out=out)
+            self.assertEqual(r.returncode, 0, r.stderr)
+        with open(self.path("a.csv"), "rb") as a, open(self.path("b.csv"), "rb") as b:
+            self.assertEqual(a.read(), b.read())
+        rows = self.read_points("a.csv")
+        self.assertEqual([r["observer_altitude_m"] for r in rows], ["0", "0", "2000"])
+        for row in rows:
+            for w in ("440", "560", "680"):
+                L, se = float(row["radiance_%snm_W_m2_sr_nm" % w]), float(row["stderr_%snm_W_m2_sr_nm" % w])
+                self.assertLessEqual(se, 0.05 * L)  # the stopping rule covers the spectral columns
+                self.assertLess(float(row["single_%snm_W_m2_sr_nm" % w]), L)
+                self.assertTrue(0.0 < float(row["sun_transmittance_%snm" % w]) < 1.0)
+            self.assertLessEqual(float(row["Y_stderr_cd_m2"]), 0.05 * float(row["Y_cd_m2"]))
+        # A higher observer sees the sun through less air.
+        self.assertGreater(float(rows[2]["sun_transmittance_440nm"]), float(rows[1]["sun_transmittance_440nm"]))
+
+    def test_points_orders_agrees_with_path(self):
+        r, _ = self.points(self.GEOM, "--method", "orders", "--quality", "low", out="o.csv")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        r, _ = self.points(self.GEOM, "--target-error", "0.02", out="p.csv")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        for o, p in zip(self.read_points("o.csv"), self.read_points("p.csv")):
+            self.assertEqual(o["stderr_440nm_W_m2_sr_nm"], "0.000e+00")
+            # docs/sky-methods.md: orders low within 3-4 % of the path tracer on the clear sky (+ 3 sigma).
+            Y, Yp, se = float(o["Y_cd_m2"]), float(p["Y_cd_m2"]), float(p["Y_stderr_cd_m2"])
+            self.assertLessEqual(abs(Y - Yp), 0.04 * Yp + 3 * se)
+            self.assertEqual(o["sun_transmittance_560nm"], p["sun_transmittance_560nm"])
+
+    def test_points_bad_altitude_and_method(self):
+        r, geom = self.points(self.GEOM.replace("60,80,30,2", "60,80,30,200"))
+        self.assertEqual(r.returncode, 1)
+        self.assertEqual(r.stderr, "sky-render: %s:5: observer_altitude_km: the observer must be inside the atmosphere "
+                                   "(0 to 100000 m), got 200000 m\n" % geom)
+        self.assertFalse(os.path.exists(self.path("out.csv")))
+        r, _ = self.points(self.GEOM, "--method", "magic")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("sky-render: --method: expected path, ", r.stderr)
+
 
 if __name__ == "__main__":
     unittest.main()

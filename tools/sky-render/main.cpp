@@ -31,6 +31,7 @@
 #include "spectrum/xyz.h"
 #include "transport/budget.h"
 #include "transport/path_tracer.h"
+#include "transport/points.h"
 #include "transport/sky_render.h"
 #include "transport/sky_scene.h"
 
@@ -101,9 +102,20 @@ int main(int argc, char** argv) {
   CLI::App* points = cli.app().add_subcommand("points", "Spectral radiance for explicit geometries (CSV in, CSV out)");
   add_scene_options(points);
   PointsOptions po;
-  points->add_option("--geometry", po.geometry, "CSV: sun_zenith_deg, view_zenith_deg, relative_azimuth_deg")->required();
+  points->add_option("--geometry", po.geometry,
+                     "CSV (first line '# source: ...'): sun_zenith_deg, view_zenith_deg, relative_azimuth_deg "
+                     "[, observer_altitude_m or _km]")
+      ->required();
   points->add_option("--wavelengths-out", po.wavelengths_nm, "Output wavelengths (nm, on the grid)")->delimiter(',')->default_str("440,550,680");
-  points->add_option("--paths", po.paths, "Paths per geometry")->default_val(100000);
+  points->add_option("--method", po.method, "path (the Monte-Carlo reference), single, orders, ms-approx or analytic")
+      ->default_val("path");
+  points->add_option("--quality", po.method_options.quality, "Deterministic methods: low, medium or high")->default_val("medium");
+  points->add_option("--spectral-stride", po.method_options.spectral_stride,
+                     "Deterministic methods: run on every k-th wavelength (and the last), the transfer interpolated")
+      ->default_val(1);
+  points->add_option("--paths", po.paths,
+                     "path: a fixed number of paths per row (default: adaptive, --target-error between --min-paths and "
+                     "--max-paths)");
 
   CLI::App* budget = cli.app().add_subcommand(
       "budget", "Which model simplifications stay under a tolerance, what each costs, which LUT dimensions can be dropped");
@@ -202,7 +214,7 @@ int main(int argc, char** argv) {
       if (!ro.preview.empty()) WriteRenderPreview(s, ro, p, ro.preview);
       cli.Info(fmt::format("{} sun angles, {} paths", p.sky.slices.size(), p.sky.total_paths));
     } else {
-      WritePoints(s, po, output);
+      WritePoints(s, po, output, cli.Progress());
     }
     if (!depfile.empty()) WriteDepfile(depfile, output, s.files_read);
   });

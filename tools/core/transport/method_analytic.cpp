@@ -102,6 +102,12 @@ class AnalyticMethod : public SkyMethod {
       sky_.Radiance(x, v, sun, steps_, out->data() + d * nw);
     }
   }
+  // The Cloud Party sky is single scattering only (no ground reflection): all of Radiance.
+  bool SingleScatteringRadiance(double observer_altitude_m, double sun_zenith_rad,
+                                const std::vector<std::array<double, 3>>& dirs, std::vector<double>* out) const override {
+    Radiance(observer_altitude_m, sun_zenith_rad, dirs, out);
+    return true;
+  }
 
  private:
   std::string quality_;

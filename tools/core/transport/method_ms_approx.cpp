@@ -185,6 +185,21 @@ class MsApproxMethod : public SkyMethod {
       ss_.MarchRay(x, v, sun, o, out->data() + d * nw);
     }
   }
+  // The same march without the multiple-scattering source (the `single` method's value).
+  bool SingleScatteringRadiance(double observer_altitude_m, double sun_zenith_rad,
+                                const std::vector<std::array<double, 3>>& dirs, std::vector<double>* out) const override {
+    const AtmosphereModel& m = ss_.model();
+    const size_t nw = m.wavelengths();
+    const glm::dvec3 x(0, 0, m.bottom_radius_m + observer_altitude_m);
+    const glm::dvec3 sun = DirectionFromAngles(sun_zenith_rad, 0.0);
+    out->assign(dirs.size() * nw, 0.0);
+    SingleScatteringModel::RayOptions o;
+    for (size_t d = 0; d < dirs.size(); ++d) {
+      const glm::dvec3 v = glm::normalize(glm::dvec3(dirs[d][0], dirs[d][1], dirs[d][2]));
+      ss_.MarchRay(x, v, sun, o, out->data() + d * nw);
+    }
+    return true;
+  }
 
  private:
   std::string quality_;

@@ -457,6 +457,13 @@ class OrdersMethod : public SkyMethod {
                 std::vector<double>* out) const override {
     Render(observer_altitude_m, sun_zenith_rad, dirs, nullptr, out);
   }
+  // L_1 of the split L = L_1 + L_ms (the exact march of the output ray), computed beside L.
+  bool SingleScatteringRadiance(double observer_altitude_m, double sun_zenith_rad,
+                                const std::vector<std::array<double, 3>>& dirs, std::vector<double>* out) const override {
+    std::vector<double> total;
+    Render(observer_altitude_m, sun_zenith_rad, dirs, nullptr, &total, out);
+    return true;
+  }
   bool SupportsSegments() const override { return true; }
   void SegmentRadiance(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,
                        const ViewSegment& segment, std::vector<double>* out) const override {
@@ -532,8 +539,9 @@ class OrdersMethod : public SkyMethod {
   }
 
   // Sky radiance (segment == nullptr) or a view segment's in-scattered radiance.
+  // With `single`, also L_1 alone (sky radiance only).
   void Render(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,
-              const ViewSegment* segment, std::vector<double>* out) const;
+              const ViewSegment* segment, std::vector<double>* out, std::vector<double>* single = nullptr) const;
 
   // The radius and view-node part of an interpolation: it depends on the point's radius and view
   // cosine only, so the table rays compute it once, not once per order, sun node and azimuth.
@@ -2138,11 +2146,12 @@ void OrdersMethod::SolveMultipleScattering(const ProgressFn& progress) {
 // ---------------------------------------------------------------------------- output
 
 void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,
-                          const ViewSegment* segment, std::vector<double>* out) const {
+                          const ViewSegment* segment, std::vector<double>* out, std::vector<double>* single) const {
   const double R = m_.bottom_radius_m, top = m_.top_radius_m;
   const double r = R + observer_altitude_m;
   const double ts = sun_zenith_rad;
   out->assign(dirs.size() * nw_, 0.0);
+  if (single != nullptr) single->assign(dirs.size() * nw_, 0.0);
   const size_t nd = nu_ * static_cast<size_t>(s_.nphi);
   // Log-linear interpolation of the MS table in the sun angle (exact for exponential twilight decay).
   const Lerp ls = Locate(sun_theta_rad_, ts);
@@ -2348,6 +2357,9 @@ void OrdersMethod::Render(double observer_altitude_m, double sun_zenith_rad, con
     if (segment != nullptr) {
       for (size_t w = 0; w < nw_; ++w) (*out)[d * nw_ + w] = acc[w] + std::max(0.0, seg_ms[w]);
       continue;
+    }
+    if (single != nullptr) {
+      for (size_t w = 0; w < nw_; ++w) (*single)[d * nw_ + w] = static_cast<double>(acc[w]);
     }
     // --- multiple scattering from the table at the observer radius
     std::fill(ms0.begin(), ms0.end(), 0.0f);

@@ -471,6 +471,12 @@ class SingleMethod : public SkyMethod {
       ss_.MarchRay(x, v, sun, o, out->data() + d * nw);
     }
   }
+  // Radiance is single scattering (and the ground's first reflection) only.
+  bool SingleScatteringRadiance(double observer_altitude_m, double sun_zenith_rad,
+                                const std::vector<std::array<double, 3>>& dirs, std::vector<double>* out) const override {
+    Radiance(observer_altitude_m, sun_zenith_rad, dirs, out);
+    return true;
+  }
 
  private:
   std::string quality_;

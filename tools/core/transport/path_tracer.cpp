@@ -272,22 +272,27 @@ void PathTracer::SegmentSunNee(const glm::dvec3& p, const glm::dvec3& d, const d
     }
   }
   if (nl == 0) return;
-  // Pieces over the lit part, weights ~ hero scattering x attenuation (midpoint rule), a
-  // piecewise-constant sampling density that is exactly known.
+  // Pieces over the lit part, weights ~ a technique wavelength's scattering x attenuation
+  // (midpoint rule), a piecewise-constant sampling density that is exactly known. One technique
+  // (the hero idx[0]), or with wavelength_mis one per carried wavelength, the piece drawn from a
+  // uniformly chosen one and its density the techniques' mixture (one-sample MIS).
   constexpr int kPieces = 64;
-  double piece_lo[kPieces + 5], piece_w[kPieces + 5], piece_len[kPieces + 5];
+  const int nh = settings_.wavelength_mis ? k : 1;
+  double piece_lo[kPieces + 5], piece_len[kPieces + 5];
+  double piece_w[kMaxWavelengths][kPieces + 5];
+  double total[kMaxWavelengths], tau[kMaxWavelengths];
+  for (int h = 0; h < nh; ++h) total[h] = tau[h] = 0.0;
   int np = 0;
-  const size_t hero = idx[0];
-  double tau = 0.0, t_prev = 0.0, total = 0.0;
-  auto extinction_at = [&](double t) {
-    const glm::dvec3 x = p + t * d;
-    return model_.Extinction(model_.Locate(glm::length(x) - R), hero);
-  };
+  double t_prev = 0.0;
   for (int i = 0; i < nl; ++i) {
     // Attenuation across the shadowed gap before this interval (4-point midpoint rule).
     if (lit_lo[i] > t_prev) {
       const double h = (lit_lo[i] - t_prev) / 4.0;
-      for (int q = 0; q < 4; ++q) tau += extinction_at(t_prev + (q + 0.5) * h) * h;
+      for (int q = 0; q < 4; ++q) {
+        const glm::dvec3 x = p + (t_prev + (q + 0.5) * h) * d;
+        const AtmosphereModel::Cell cell = model_.Locate(glm::length(x) - R);
+        for (int hh = 0; hh < nh; ++hh) tau[hh] += model_.Extinction(cell, idx[hh]) * h;
+      }
     }
     const int n = std::max(1, static_cast<int>(std::round(kPieces * (lit_hi[i] - lit_lo[i]) / lit_len)));
     const double h = (lit_hi[i] - lit_lo[i]) / n;
@@ -295,30 +300,42 @@ void PathTracer::SegmentSunNee(const glm::dvec3& p, const glm::dvec3& d, const d
       const double tm = lit_lo[i] + (q + 0.5) * h;
       const glm::dvec3 x = p + tm * d;
       const AtmosphereModel::Cell cell = model_.Locate(glm::length(x) - R);
-      const double ext = model_.Extinction(cell, hero);
-      const double w = model_.Scattering(cell, hero) * std::exp(-(tau + 0.5 * ext * h)) * h;
-      tau += ext * h;
+      for (int hh = 0; hh < nh; ++hh) {
+        const double ext = model_.Extinction(cell, idx[hh]);
+        const double w = model_.Scattering(cell, idx[hh]) * std::exp(-(tau[hh] + 0.5 * ext * h)) * h;
+        tau[hh] += ext * h;
+        piece_w[hh][np] = w;
+        total[hh] += w;
+      }
       piece_lo[np] = lit_lo[i] + q * h;
       piece_len[np] = h;
-      piece_w[np] = w;
-      total += w;
       ++np;
     }
     t_prev = lit_hi[i];
   }
-  if (!(total > 0.0)) return;
-  double u = rng.Uniform() * total;
+  // The techniques that can sample (a wavelength that does not scatter anywhere here cannot).
+  int usable[kMaxWavelengths];
+  int nu = 0;
+  for (int hh = 0; hh < nh; ++hh) {
+    if (total[hh] > 0.0) usable[nu++] = hh;
+  }
+  if (nu == 0) return;
+  int tech = usable[0];
+  if (nh > 1) tech = usable[std::min(nu - 1, static_cast<int>(rng.Uniform() * nu))];
+  double u = rng.Uniform() * total[tech];
   int chosen = np - 1;
   for (int i = 0; i < np; ++i) {
-    if (u < piece_w[i]) {
+    if (u < piece_w[tech][i]) {
       chosen = i;
       break;
     }
-    u -= piece_w[i];
+    u -= piece_w[tech][i];
   }
-  if (piece_w[chosen] <= 0.0) return;
+  if (piece_w[tech][chosen] <= 0.0) return;
   const double t_star = piece_lo[chosen] + rng.Uniform() * piece_len[chosen];
-  const double pdf = piece_w[chosen] / (total * piece_len[chosen]);
+  double pdf = 0.0;
+  for (int q = 0; q < nu; ++q) pdf += piece_w[usable[q]][chosen] / (total[usable[q]] * piece_len[chosen]);
+  pdf /= nu;
   const glm::dvec3 x = p + t_star * d;
   const AtmosphereModel::Cell cell = model_.Locate(glm::length(x) - R);
   // Sun direction in the disk's cone.
@@ -342,8 +359,25 @@ void PathTracer::SegmentSunNee(const glm::dvec3& p, const glm::dvec3& d, const d
   for (int j = 0; j < k; ++j) L[j] += f[j] * t_view[j] * t_sun[j] * sm.Radiance(idx[j], alpha) * omega / pdf;
 }
 
+namespace {
+// Copies the radiance gathered so far into L1 once: when the path reaches its first scattering
+// or reflection event (every later sun connection is of order >= 2) or ends before it.
+struct FirstOrderCapture {
+  double* L1;
+  const double* L;
+  int k;
+  bool done = false;
+  void Take() {
+    if (L1 == nullptr || done) return;
+    for (int j = 0; j < k; ++j) L1[j] = L[j];
+    done = true;
+  }
+  ~FirstOrderCapture() { Take(); }
+};
+}  // namespace
+
 void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, const size_t* idx, int k, Pcg32& rng,
-                           double* L, double view_t_end, bool single_scattering) const {
+                           double* L, double view_t_end, bool single_scattering, double* L1) const {
   // Segment mode (view_t_end finite): the first flight ends at view_t_end, the path dies there
   // and at the ground (no surface term); later flights are unrestricted.
   const bool segment = std::isfinite(view_t_end);
@@ -357,9 +391,11 @@ void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, co
   const bool segment_nee = sun_mode && settings_.segment_nee;
   const int max_order = settings_.max_order > 0 ? settings_.max_order : std::numeric_limits<int>::max();
   size_t s = ShellOf(glm::length(p));
+  FirstOrderCapture first{L1, L, k};
   // `depth` = scattering and reflection events so far; a sun connection made now is of order
   // depth + 1.
   for (int depth = 0; depth < 100000; ++depth) {
+    if (depth == 1) first.Take();
     // Order-1 sun connections are skipped when single scattering is excluded (shadowed fog).
     const bool nee_here = depth + 1 <= max_order && (single_scattering || depth > 0);
     if (segment_nee && nee_here) {
@@ -433,6 +469,7 @@ void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, co
     }
 
     if (event == Event::kEscape) {
+      if (depth == 0) first.Take();  // the unscattered light from space (uniform mode) is order 0
       if (!sun_mode && depth <= max_order) {
         for (int j = 0; j < k; ++j) L[j] += beta[j];  // uniform radiance 1 from space
       }
@@ -480,14 +517,22 @@ void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, co
         if (u < sel[c]) break;
         u -= sel[c];
       }
-      const size_t hero = idx[0];
-      const double mu = model_.components[chosen].phase->SampleMu(hero, rng.Uniform());
+      // The technique wavelength: the hero, or (wavelength_mis) one of the k drawn uniformly,
+      // the pdf then the mixture over the k (one-sample MIS).
+      const int nh = settings_.wavelength_mis ? k : 1;
+      const int tech = nh > 1 ? std::min(nh - 1, static_cast<int>(rng.Uniform() * nh)) : 0;
+      const double mu = model_.components[chosen].phase->SampleMu(idx[tech], rng.Uniform());
       const glm::dvec3 d_new = RotateAround(d, mu, 2.0 * kPi * rng.Uniform());
       // Mixture pdf (solid angle) of the sampled direction.
       double pdf = 0.0;
-      for (size_t c = 0; c < nc; ++c) {
-        if (sel[c] > 0.0) pdf += sel[c] / total * model_.components[c].phase->Eval(hero, mu);
+      for (int h = 0; h < nh; ++h) {
+        double ph = 0.0;
+        for (size_t c = 0; c < nc; ++c) {
+          if (sel[c] > 0.0) ph += sel[c] / total * model_.components[c].phase->Eval(idx[h], mu);
+        }
+        pdf += ph;
       }
+      pdf /= nh;
       if (!(pdf > 0.0)) return;
       for (int j = 0; j < k; ++j) beta[j] *= MixturePhase(cell, idx[j], mu) / pdf;
       d = d_new;  // the vertex is inside shell s: the traversal continues from there
@@ -504,38 +549,51 @@ void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, co
   }
 }
 
-ColorEstimate PathTracer::Estimate(const glm::dvec3& position, const glm::dvec3& direction,
-                                   const glm::dvec3& sun_direction, uint64_t stream, bool cosine_hemisphere,
-                                   double view_t_end, bool single_scattering) const {
+glm::dvec3 PathTracer::StartPoint(const glm::dvec3& position) const {
+  if (glm::length(position) < model_.bottom_radius_m + 1e-3) return glm::normalize(position) * (model_.bottom_radius_m + 1e-3);
+  return position;
+}
+
+void PathTracer::SamplePath(const glm::dvec3& position, const glm::dvec3& direction, const glm::dvec3& sun_direction,
+                            uint64_t stream, uint64_t n, bool cosine_hemisphere, double view_t_end,
+                            bool single_scattering, double* xyz) const {
+  const glm::dvec3 start = StartPoint(position);
   const size_t n_wl = model_.wavelengths();
   const int k = static_cast<int>(std::min<size_t>(static_cast<size_t>(settings_.wavelengths_per_path), n_wl));
   const double scale = static_cast<double>(n_wl) / k;
+  Pcg32 rng(settings_.seed, stream, n);
+  size_t idx[kMaxWavelengths];
+  const size_t hero = std::min(n_wl - 1, static_cast<size_t>(rng.Uniform() * static_cast<double>(n_wl)));
+  for (int j = 0; j < k; ++j) idx[j] = (hero + static_cast<size_t>(j) * n_wl / static_cast<size_t>(k)) % n_wl;
+  glm::dvec3 d = direction;
+  double weight = 1.0;
+  if (cosine_hemisphere) {
+    d = CosineHemisphere(glm::normalize(position), rng.Uniform(), rng.Uniform());
+    weight = kPi;  // E = pi E_cos[L]
+  }
+  double L[kMaxWavelengths];
+  TracePath(start, d, sun_direction, idx, k, rng, L, view_t_end, single_scattering);
+  for (int c = 0; c < 3; ++c) xyz[c] = 0.0;
+  for (int j = 0; j < k; ++j) {
+    for (int c = 0; c < 3; ++c) xyz[c] += scale * weight * xyz_weights_[idx[j]][static_cast<size_t>(c)] * L[j];
+  }
+}
+
+void PathTracer::ColorPath(const glm::dvec3& position, const glm::dvec3& direction, const glm::dvec3& sun_direction,
+                           uint64_t stream, uint64_t n, double* xyz) const {
+  SamplePath(position, direction, sun_direction, stream, n, false, std::numeric_limits<double>::infinity(), true, xyz);
+}
+
+ColorEstimate PathTracer::Estimate(const glm::dvec3& position, const glm::dvec3& direction,
+                                   const glm::dvec3& sun_direction, uint64_t stream, bool cosine_hemisphere,
+                                   double view_t_end, bool single_scattering) const {
   // Welford accumulators for X, Y, Z.
   double mean[3] = {0, 0, 0}, m2[3] = {0, 0, 0};
   uint64_t n = 0;
-  const glm::dvec3 up = glm::normalize(position);
-  // An observer on the ground starts 1 mm above it (as ground bounces do), so that views below
-  // the horizon hit the ground at once.
-  glm::dvec3 start = position;
-  if (glm::length(start) < model_.bottom_radius_m + 1e-3) start = up * (model_.bottom_radius_m + 1e-3);
   for (;;) {
     for (uint64_t b = 0; b < settings_.batch_paths; ++b, ++n) {
-      Pcg32 rng(settings_.seed, stream, n);
-      size_t idx[kMaxWavelengths];
-      const size_t hero = std::min(n_wl - 1, static_cast<size_t>(rng.Uniform() * static_cast<double>(n_wl)));
-      for (int j = 0; j < k; ++j) idx[j] = (hero + static_cast<size_t>(j) * n_wl / static_cast<size_t>(k)) % n_wl;
-      glm::dvec3 d = direction;
-      double weight = 1.0;
-      if (cosine_hemisphere) {
-        d = CosineHemisphere(up, rng.Uniform(), rng.Uniform());
-        weight = kPi;  // E = pi E_cos[L]
-      }
-      double L[kMaxWavelengths];
-      TracePath(start, d, sun_direction, idx, k, rng, L, view_t_end, single_scattering);
-      double xyz[3] = {0, 0, 0};
-      for (int j = 0; j < k; ++j) {
-        for (int c = 0; c < 3; ++c) xyz[c] += scale * weight * xyz_weights_[idx[j]][static_cast<size_t>(c)] * L[j];
-      }
+      double xyz[3];
+      SamplePath(position, direction, sun_direction, stream, n, cosine_hemisphere, view_t_end, single_scattering, xyz);
       const double nn = static_cast<double>(n + 1);
       for (int c = 0; c < 3; ++c) {
         const double delta = xyz[c] - mean[c];

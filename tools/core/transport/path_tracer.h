@@ -72,6 +72,18 @@ struct PathTracerSettings {
   bool segment_nee = true;
   // Highest scattering order counted (ground reflections count as orders); 0 = all orders.
   int max_order = 0;
+  // Wavelength-sampling decisions (the segment-NEE point, the phase-function direction).
+  // false: they follow the path's first wavelength idx[0] (the hero), and every other carried
+  // wavelength is weighted by f(lambda_j) / p(lambda_0): unbiased, but where p(lambda_0) is small
+  // and f(lambda_j) is not (a 680 nm point far along a ray whose 440 nm attenuation is strong) the
+  // weights have a heavy tail, and the sample variance of a modest number of paths
+  // underestimates the true one. true: one-sample multiple importance sampling over the carried
+  // wavelengths (Veach 1997, §9.2.4, the balance heuristic): each decision draws its technique
+  // h uniformly among the k wavelengths, samples from p(lambda_h), and divides every wavelength's
+  // contribution by the mixture (1/k) sum_h p(lambda_h); each weight is then bounded by k times
+  // the single-wavelength one, so every carried wavelength gets an honest error bar (sky-render
+  // points; tests/transport/points_test.cpp measures the coverage).
+  bool wavelength_mis = false;
 };
 
 // Mean and standard error of an estimated colour (XYZ: cd/m^2 for radiance, lux for irradiance).
@@ -112,10 +124,20 @@ class PathTracer {
 
   // One path: L[j] for the k wavelengths idx[j] (k <= kMaxWavelengths).
   // A finite `view_t_end` restricts the first flight to [0, view_t_end] with no ground surface
-  // (segment mode, as SegmentRadiance).
+  // (segment mode, as SegmentRadiance). With `L1`, L1[j] receives the path's order-1 part (the
+  // sun connections made before the first scattering or reflection event: single scattering and
+  // the ground's reflection of the direct sun), an unbiased estimate of the single-scattered
+  // radiance from the same path (no extra random numbers).
   void TracePath(glm::dvec3 position, glm::dvec3 direction, const glm::dvec3& sun_direction, const size_t* idx, int k,
                  Pcg32& rng, double* L, double view_t_end = std::numeric_limits<double>::infinity(),
-                 bool single_scattering = true) const;
+                 bool single_scattering = true, double* L1 = nullptr) const;
+  // One path of the colour estimator (Radiance): the hero wavelength and its partners drawn from
+  // the path's own stream (seed, stream, n), xyz = (N/K) sum_j w(lambda_j) L(lambda_j).
+  void ColorPath(const glm::dvec3& position, const glm::dvec3& direction, const glm::dvec3& sun_direction, uint64_t stream,
+                 uint64_t n, double* xyz) const;
+  // An observer on the ground starts 1 mm above it (as ground bounces do), so that views below
+  // the horizon hit the ground at once.
+  glm::dvec3 StartPoint(const glm::dvec3& position) const;
   // Ratio-tracking transmittance from `position` along `direction` to the top of the
   // atmosphere (0 if the ray hits the ground) for k wavelengths.
   void Transmittance(const glm::dvec3& position, const glm::dvec3& direction, const size_t* idx, int k, Pcg32& rng,
@@ -136,6 +158,8 @@ class PathTracer {
  private:
   ColorEstimate Estimate(const glm::dvec3& position, const glm::dvec3& direction, const glm::dvec3& sun_direction,
                          uint64_t stream, bool cosine_hemisphere, double view_t_end, bool single_scattering) const;
+  void SamplePath(const glm::dvec3& position, const glm::dvec3& direction, const glm::dvec3& sun_direction, uint64_t stream,
+                  uint64_t n, bool cosine_hemisphere, double view_t_end, bool single_scattering, double* xyz) const;
   size_t ShellOf(double radius) const;
   double Majorant(size_t shell, const size_t* idx, int k) const;
   // Sun next-event estimate at a medium or ground vertex: adds to L.

@@ -52,6 +52,14 @@ class SkyMethod {
   // medium at t <= t_end, no ground surface), same layout as Radiance. Methods that cannot
   // cut the view ray throw UsageError (the default).
   virtual bool SupportsSegments() const { return false; }
+  // The single-scattering part of Radiance (order 1: the sun scattered once along the view ray,
+  // and the ground's reflection of the direct sun), same layout; false (out untouched) where the
+  // method does not separate it.
+  virtual bool SingleScatteringRadiance(double observer_altitude_m, double sun_zenith_rad,
+                                        const std::vector<std::array<double, 3>>& dirs, std::vector<double>* out) const {
+    (void)observer_altitude_m, (void)sun_zenith_rad, (void)dirs, (void)out;
+    return false;
+  }
   virtual void SegmentRadiance(double observer_altitude_m, double sun_zenith_rad,
                                const std::vector<std::array<double, 3>>& dirs, const ViewSegment& segment,
                                std::vector<double>* out) const;

@@ -324,48 +324,4 @@ void WriteRenderPreview(const Scene& scene, const RenderOptions& o, const Render
   WritePng8(path, g.width(), g.height() * static_cast<int>(p.sky.slices.size()), 3, montage);
 }
 
-void WritePoints(const Scene& scene, const PointsOptions& o, const fs::path& path) {
-  CsvTable csv = CsvTable::Load(o.geometry);
-  Diagnostics d;
-  std::vector<double> sza = csv.Numbers("sun_zenith_deg", d);
-  std::vector<double> vza = csv.Numbers("view_zenith_deg", d);
-  std::vector<double> raz = csv.Numbers("relative_azimuth_deg", d);
-  for (size_t r = 0; r < csv.rows() && d.empty(); ++r) {
-    if (sza[r] < 0 || sza[r] > 180) d.Add(csv.LocOfRow(r), "sun_zenith_deg must be in 0-180");
-    if (vza[r] < 0 || vza[r] > 180) d.Add(csv.LocOfRow(r), "view_zenith_deg must be in 0-180");
-  }
-  d.ThrowIfAny();
-  std::vector<size_t> idx;
-  for (double w : o.wavelengths_nm) {
-    auto it = std::find_if(scene.grid.wavelength_nm().begin(), scene.grid.wavelength_nm().end(),
-                           [&](double g) { return std::abs(g - w) < 1e-9; });
-    if (it == scene.grid.wavelength_nm().end()) throw UsageError(fmt::format("--wavelengths-out: {} nm is not on the grid", w));
-    idx.push_back(static_cast<size_t>(it - scene.grid.wavelength_nm().begin()));
-  }
-  PathTracer tracer(scene.model, scene.xyz_weights, scene.tracer);
-  const glm::dvec3 observer(0, 0, scene.model.bottom_radius_m + scene.spec.observer_altitude_m);
-  std::string out = "# source: sky-render points (path tracer, " + std::to_string(o.paths) +
-                    " paths per row); relative_azimuth_deg = 0 looks towards the sun's azimuth; L/E0 = radiance per unit "
-                    "extraterrestrial irradiance on a surface normal to the sun (sr^-1)\n";
-  out += "sun_zenith_deg,view_zenith_deg,relative_azimuth_deg";
-  for (double w : o.wavelengths_nm) {
-    out += fmt::format(",radiance_{0}nm_W_m2_sr_nm,stderr_{0}nm_W_m2_sr_nm,radiance_over_e0_{0}nm_per_sr", w);
-  }
-  out += ",Y_cd_m2,Y_stderr_cd_m2\n";
-  const double deg = 3.14159265358979323846 / 180.0;
-  for (size_t r = 0; r < csv.rows(); ++r) {
-    const glm::dvec3 sun = DirectionFromAngles(sza[r] * deg, 0.0);
-    const glm::dvec3 view = DirectionFromAngles(vza[r] * deg, raz[r] * deg);
-    std::vector<double> mean, se;
-    tracer.SpectralRadiance(observer, view, sun, idx, o.paths, r, &mean, &se);
-    ColorEstimate c = tracer.Radiance(observer, view, sun, (uint64_t{1} << 32) + r);
-    out += fmt::format("{},{},{}", FormatExact(sza[r]), FormatExact(vza[r]), FormatExact(raz[r]));
-    for (size_t j = 0; j < idx.size(); ++j) {
-      out += fmt::format(",{:.6e},{:.3e},{:.6e}", mean[j], se[j], mean[j] / scene.model.sun.irradiance[idx[j]]);
-    }
-    out += fmt::format(",{:.6e},{:.3e}\n", c.xyz[1], c.xyz_stderr[1]);
-  }
-  WriteFileIfChanged(path, out);
-}
-
 }  // namespace skybake

@@ -97,11 +97,4 @@ void WriteRender(const Scene& scene, const RenderOptions& options, const RenderP
 void WriteRenderPreview(const Scene& scene, const RenderOptions& options, const RenderProducts& products,
                         const std::filesystem::path& path);
 
-struct PointsOptions {
-  std::string geometry;
-  std::vector<double> wavelengths_nm;
-  uint64_t paths = 100000;
-};
-void WritePoints(const Scene& scene, const PointsOptions& options, const std::filesystem::path& path);
-
 }  // namespace skybake

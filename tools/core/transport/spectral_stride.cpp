@@ -57,6 +57,13 @@ class SpectralStrideMethod : public SkyMethod {
     Expand(sub, dirs.size(), out);
   }
   bool SupportsSegments() const override { return inner_->SupportsSegments(); }
+  bool SingleScatteringRadiance(double h, double sz, const std::vector<std::array<double, 3>>& dirs,
+                                std::vector<double>* out) const override {
+    std::vector<double> sub;
+    if (!inner_->SingleScatteringRadiance(h, sz, dirs, &sub)) return false;
+    Expand(sub, dirs.size(), out);
+    return true;
+  }
   void SegmentRadiance(double h, double sz, const std::vector<std::array<double, 3>>& dirs, const ViewSegment& seg,
                        std::vector<double>* out) const override {
     std::vector<double> sub;
