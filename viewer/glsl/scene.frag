@@ -182,8 +182,8 @@ void main() {
       color = color * c.a + c.rgb;
     }
   } else {
-    // The ground: Lambertian, lit by the sun (shadowed by the clouds) and the ambient sky; rings
-    // at 100 m, 1, 5, 10, 20 and 50 km mark the distance (the fog's scale).
+    // The ground: Lambertian, lit by the sun (shadowed by the clouds) and the ambient sky, with
+    // marks of the distance (the fog's scale).
     depth = uEyeHeight / -d.z;
     vec3 p = d * depth;
     float shadow = 1.0;
@@ -191,13 +191,23 @@ void main() {
       float toBase = sphereExit(kPlanetRadius, sunW.z, kPlanetRadius + uCoverageAlt.x);
       shadow = exp(-sunOpticalDepth(p + sunW * toBase, sunW));
     }
-    float albedo = uGroundAlbedo;
+    // Checkers of 10 m, 100 m and 1 km cells (albedo uGroundAlbedo -/+ 10 % each), each faded
+    // where a pixel covers a quarter of its cell (no mipmaps: it would alias), and rings at 100 m,
+    // 1, 5, 10, 20 and 50 km, about a pixel wide.
     float r = length(p.xy);
     float pixelAngle = 2.0 * uTanHalfFov / uResolution.y;
-    float width = max(r * pixelAngle / max(-d.z, 1e-3), 0.004 * r);  // about a pixel, at least 0.4 % of r
+    float footprint = r * pixelAngle / max(-d.z, 1e-4);  // m of ground under one pixel, along the view
+    float modulation = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      float size = k == 0 ? 10.0 : k == 1 ? 100.0 : 1000.0;
+      vec2 cell = floor(p.xy / size);
+      modulation += 0.1 * (mod(cell.x + cell.y, 2.0) * 2.0 - 1.0) * clamp(1.0 - 4.0 * footprint / size, 0.0, 1.0);
+    }
+    float albedo = uGroundAlbedo * (1.0 + modulation);
+    float width = max(r * pixelAngle, 0.5 * footprint);
     for (int k = 0; k < 6; ++k) {
       float ring = k == 0 ? 100.0 : k == 1 ? 1000.0 : k == 2 ? 5000.0 : k == 3 ? 10000.0 : k == 4 ? 20000.0 : 50000.0;
-      if (abs(r - ring) < width) albedo = 0.6;
+      if (abs(r - ring) < width) albedo = 2.0 * uGroundAlbedo;
     }
     vec3 e = eSun * max(sunW.z, 0.0) * shadow + eAmb;
     color = albedo / SB_PI * e;

@@ -508,8 +508,8 @@ function drawScale() {
   for (let e = lo; e <= hi; ++e) {
     const x = (e - lo) / (hi - lo) * (c.width - 1);
     g.fillRect(x, 14, 1, 4);
-    const label = e < 0 ? `0.${"0".repeat(-e - 1)}1` : `${10 ** e}`;
-    g.fillText(label, Math.min(Math.max(x - 8, 0), c.width - 36), 30);
+    const label = e < 0 ? `0.${"0".repeat(-e - 1)}1` : e < 3 ? `${10 ** e}` : `${10 ** (e - 3)}k`;
+    g.fillText(label, Math.min(Math.max(x - 0.5 * g.measureText(label).width, 0), c.width - g.measureText(label).width), 30);
   }
 }
 
