@@ -5,6 +5,8 @@
 #include <tbb/global_control.h>
 
 #include <chrono>
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <mutex>
@@ -57,6 +59,27 @@ ProgressFn ToolCli::Progress() {
   };
 }
 
+namespace {
+
+// CLI11's numeric validators (Range, PositiveNumber, ...) compare with < and >, which a NaN
+// passes, and its double options accept "nan" and "inf": every floating-point option of the
+// parsed (sub)commands is checked here to be a finite number before the tool does any work.
+void CheckFiniteOptions(CLI::App* app) {
+  for (CLI::Option* opt : app->get_options()) {
+    if (opt->count() == 0 || opt->get_type_name().find("FLOAT") == std::string::npos) continue;
+    for (const std::string& r : opt->results()) {
+      char* end = nullptr;
+      const double v = std::strtod(r.c_str(), &end);
+      if (end != r.c_str() && !std::isfinite(v)) {
+        throw UsageError(opt->get_name() + " " + r + ": expected a finite number");
+      }
+    }
+  }
+  for (CLI::App* sub : app->get_subcommands()) CheckFiniteOptions(sub);
+}
+
+}  // namespace
+
 int ToolCli::Run(int argc, char** argv, const std::function<void()>& body) {
   // Plain stderr sink: no colours (ninja and CI logs), the tool name as prefix.
   progress_->logger = std::make_shared<spdlog::logger>(name_, std::make_shared<spdlog::sinks::stderr_sink_mt>());
@@ -73,6 +96,7 @@ int ToolCli::Run(int argc, char** argv, const std::function<void()>& body) {
                                                             static_cast<size_t>(threads_));
   }
   try {
+    CheckFiniteOptions(&app_);
     body();
     return 0;
   } catch (const InputError& e) {
