@@ -205,6 +205,38 @@ class HostileInputs(TempDirTestCase):
                          "is its name and must be a lowercase identifier (a-z, 0-9, _; starting with a letter) "
                          "with .yaml" % (atm, line))
 
+    # Stale temporary files of a killed run are removed by the next run
+    def test_stale_temporary_files_are_removed_by_the_next_run(self):
+        out = self.path("p.exr")
+        dead = 2 ** 22 + 12345  # above the default pid_max: no such process
+        stale = [out + ".tmp-%d" % dead, out + ".d.tmp-%d" % dead]
+        for s in stale:
+            with open(s, "wb") as f:
+                f.write(b"half a file")
+        r = run([tool("profile-import"), self.path("atmospheres", "clear.yaml"), "-o", out, "--depfile", out + ".d"])
+        self.assertEqual(r.returncode, 0, r.stderr)
+        self.assertEqual(sorted(os.listdir(self.tmp)), ["atmospheres", "p.exr", "p.exr.d", "particles"])
+
+    def test_a_dead_runs_journal_is_completed_by_the_next_run(self):
+        # A run killed between its renames: the journal lists the targets, one staged file is
+        # still there; the next run renames it over its target and removes the journal.
+        dead = 2 ** 22 + 12346
+        a, b = self.path("a.bin"), self.path("b.bin")
+        with open(a, "wb") as f:
+            f.write(b"new a")  # already renamed
+        with open(b, "wb") as f:
+            f.write(b"old b")
+        with open(b + ".tmp-%d" % dead, "wb") as f:
+            f.write(b"new b")
+        with open(self.path(".skybake-commit-%d" % dead), "w") as f:
+            f.write(a + "\n" + b + "\n")
+        out = self.path("p.exr")
+        r = run([tool("profile-import"), self.path("atmospheres", "clear.yaml"), "-o", out])
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(b, "rb") as f:
+            self.assertEqual(f.read(), b"new b")
+        self.assertEqual(sorted(os.listdir(self.tmp)), ["a.bin", "atmospheres", "b.bin", "p.exr", "particles"])
+
 
 if __name__ == "__main__":
     unittest.main()

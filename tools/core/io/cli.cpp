@@ -12,6 +12,7 @@
 #include <mutex>
 
 #include "io/error.h"
+#include "io/fileio.h"
 #include "skybake/version.h"
 
 namespace skybake {
@@ -95,9 +96,20 @@ int ToolCli::Run(int argc, char** argv, const std::function<void()>& body) {
     threads_control = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                             static_cast<size_t>(threads_));
   }
+  // One output transaction per command (io/fileio.h): the body's files become visible together
+  // when it succeeds, and none of them when it throws.
+  struct TransactionGuard {
+    bool done = false;
+    TransactionGuard() { BeginOutputTransaction(); }
+    ~TransactionGuard() {
+      if (!done) AbortOutputTransaction();
+    }
+  } transaction;
   try {
     CheckFiniteOptions(&app_);
     body();
+    CommitOutputTransaction();
+    transaction.done = true;
     return 0;
   } catch (const InputError& e) {
     for (const Diagnostic& d : e.diagnostics()) std::cerr << name_ << ": " << d.ToString() << "\n";
