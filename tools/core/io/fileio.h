@@ -55,8 +55,10 @@ void WriteDepfile(const std::filesystem::path& depfile, const std::filesystem::p
 std::string HashBytes(std::string_view bytes);
 std::string HashFile(const std::filesystem::path& path);
 
-// Test hook, documented in docs/testing.md: when the environment variable
+// Test hooks (tests/cli/test_kill.py): when the environment variable
 // SKYBAKE_TEST_SLOW_WRITE_MS is set, WriteFileIfChanged writes its temporary file in small
 // chunks with that many milliseconds between them, so a test can kill a tool mid-write.
+// SKYBAKE_TEST_SLOW_COMMIT_MS pauses that long after each rename of a commit, so that a kill
+// lands between the renames (tests/cli/test_kill.py).
 
 }  // namespace skybake
