@@ -153,6 +153,16 @@ class HostileInputs(TempDirTestCase):
                 self.assertEqual(messages(r.stderr)[0], message)
                 self.assertUntouched(outs)
 
+    # mie-tables sphere: a size parameter or index without end ran forever, a tiny one gave NaN
+    def test_single_sphere_outside_its_range_is_a_usage_error(self):
+        for args in (["--m", "1.33", "--x", "1e300"], ["--m", "1.33", "--x", "1e-300"], ["--m", "1e300", "--x", "1"],
+                     ["--m", "1.5+1e300i", "--x", "1"], ["--m", "1.33", "--x", "nan"]):
+            with self.subTest(args=args):
+                r = run([tool("mie-tables"), "sphere"] + args + ["-o", self.path("out.json")], timeout=20)
+                self.assertEqual(r.returncode, 2, r.stderr)
+                self.assertTrue(r.stderr.startswith("mie-tables: --"), r.stderr)
+                self.assertFalse(os.path.exists(self.path("out.json")))
+
     # --preview with a bad --display / --white-cd-m2 fails before rendering, the old set intact
     def test_preview_options_are_checked_before_the_render(self):
         clear = self.plain
