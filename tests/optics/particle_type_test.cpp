@@ -157,11 +157,11 @@ TEST(ParticleType, BadInputsAreReportedWithFileAndLine) {
   EXPECT_EQ(with("r_min_um: 0.05", "r_min_um: -1"),
             f + ":7: key 'modes[0].r_min_um': expected a number from 1e-04 to 100 in um, got \"-1\"\n");
   EXPECT_EQ(with("ln_sigma_g: 0.45", "ln_sigma_g: 0"),
-            f + ":6: key 'modes[0].ln_sigma_g': expected a number above 0 and at most 1.609 (ln 5), got \"0\"\n");
+            f + ":6: key 'modes[0].ln_sigma_g': expected a number from 0.0001 to 1.609 (ln 5), got \"0\"\n");
   EXPECT_EQ(with("ln_sigma_g: 0.45", "sigma_g: 1.0"),
-            f + ":6: key 'modes[0].sigma_g': expected a number above 1 and at most 5, got \"1.0\"\n");
+            f + ":6: key 'modes[0].sigma_g': expected a number from 1.0001 to 5, got \"1.0\"\n");
   EXPECT_EQ(with("ln_sigma_g: 0.45", "sigma_g: 0.45"),
-            f + ":6: key 'modes[0].sigma_g': expected a number above 1 and at most 5, got \"0.45\"\n");
+            f + ":6: key 'modes[0].sigma_g': expected a number from 1.0001 to 5, got \"0.45\"\n");
   EXPECT_EQ(with("r_max_um: 15", "r_max_um: 0.05"),
             f + ":8: key 'modes[0].r_max_um': must be greater than r_min_um (0.05 <= 0.05)\n");
   EXPECT_EQ(with("median_radius_um: 0.12", "median_radius_um: .nan"),
@@ -173,7 +173,7 @@ TEST(ParticleType, BadInputsAreReportedWithFileAndLine) {
   EXPECT_EQ(with("r_max_um: 15", "r_max_um: 1e20"),
             f + ":8: key 'modes[0].r_max_um': expected a number from 1e-04 to 100 in um, got \"1e20\"\n");
   EXPECT_EQ(with("ln_sigma_g: 0.45", "sigma_g: 1e9"),
-            f + ":6: key 'modes[0].sigma_g': expected a number above 1 and at most 5, got \"1e9\"\n");
+            f + ":6: key 'modes[0].sigma_g': expected a number from 1.0001 to 5, got \"1e9\"\n");
   EXPECT_EQ(with("basis: volume", "basis: volume\n    sigma: 2.0"),
             f + ":5: unknown key 'modes[0].sigma' (did you mean 'sigma_g'?)\n");
   EXPECT_EQ(with("ln_sigma_g: 0.45", "ln_sigma_g: 0.45\n    sigma_g: 1.5"),

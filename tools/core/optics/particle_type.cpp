@@ -26,19 +26,18 @@ bool IsIdentifier(const std::string& s) {
   return true;
 }
 
-// Ranges of the mode parameters (docs/mie.md, "Valid ranges"): sigma_g in (1, 5] (OPAC's widest
+// Ranges of the mode parameters (docs/mie.md, "Valid ranges"): sigma_g in [1.0001, 5] (narrower
+// is a single sphere, and the radius quadrature has no panel left; OPAC's widest
 // mode, mineral nucleation, has sigma_g = 1.95; 5 keeps the distribution inside 1e-4-100 um), a
 // weight in (0, 1e12] (number densities in cm^-3 up to 1e12 or relative values).
 NumberSpec SigmaG() {
-  NumberSpec s = NumberSpec::Range(1.0, 5.0, "");
-  s.min_inclusive = false;
-  s.description = "a number above 1 and at most 5";
+  NumberSpec s = NumberSpec::Range(1.0001, 5.0, "");
+  s.description = "a number from 1.0001 to 5";
   return s;
 }
 NumberSpec LnSigmaG() {
-  NumberSpec s = NumberSpec::Range(0.0, 1.6094379124341003, "");  // ln 5
-  s.min_inclusive = false;
-  s.description = "a number above 0 and at most 1.609 (ln 5)";
+  NumberSpec s = NumberSpec::Range(1e-4, 1.6094379124341003, "");  // ln 5
+  s.description = "a number from 0.0001 to 1.609 (ln 5)";
   return s;
 }
 NumberSpec Weight() {
