@@ -6,6 +6,12 @@ target_compile_options(skybake_warnings INTERFACE -Wall -Wextra -Wpedantic -Wsha
 if(SKYBAKE_SANITIZE)
   target_compile_options(skybake_warnings INTERFACE -fsanitize=address,undefined -fno-omit-frame-pointer)
   target_link_options(skybake_warnings INTERFACE -fsanitize=address,undefined)
+  # Any UBSan finding fails the run (a report is otherwise only a message).
+  target_compile_options(skybake_warnings INTERFACE -fno-sanitize-recover=undefined)
+endif()
+if(SKYBAKE_FUZZ)
+  # Coverage instrumentation for libFuzzer in every skybake target (fuzz targets link -fsanitize=fuzzer).
+  target_compile_options(skybake_warnings INTERFACE -fsanitize=fuzzer-no-link)
 endif()
 
 # skybake_add_core_module(NAME <module> DEPS <targets...>)

@@ -145,13 +145,13 @@ class MieTablesCli(CliContract, TempDirTestCase):
 
     def test_bad_particle_file_is_reported_with_file_and_line(self):
         p, err = self.bad(GOOD_TYPE.replace("r_min_um: 0.05", "r_min_um: -1"))
-        self.assertEqual(err, "mie-tables: %s:7: key 'modes[0].r_min_um': expected a positive number in um, got \"-1\"\n" % p)
+        self.assertEqual(err, "mie-tables: %s:7: key 'modes[0].r_min_um': expected a number from 1e-04 to 100 in um, got \"-1\"\n" % p)
         p, err = self.bad(GOOD_TYPE.replace("ln_sigma_g: 0.45", "sigma_g: 0.45"))
-        self.assertEqual(err, "mie-tables: %s:6: key 'modes[0].sigma_g': expected a number greater than 1, got \"0.45\"\n" % p)
+        self.assertEqual(err, "mie-tables: %s:6: key 'modes[0].sigma_g': expected a number from 1.0001 to 5, got \"0.45\"\n" % p)
         p, err = self.bad(GOOD_TYPE.replace("r_max_um: 15", "r_max_um: 0.01"))
         self.assertEqual(err, "mie-tables: %s:8: key 'modes[0].r_max_um': must be greater than r_min_um (0.01 <= 0.05)\n" % p)
         p, err = self.bad(GOOD_TYPE.replace("median_radius_um: 0.12", "median_radius_um: .nan"))
-        self.assertEqual(err, "mie-tables: %s:5: key 'modes[0].median_radius_um': expected a positive number in um, got \".nan\"\n" % p)
+        self.assertEqual(err, "mie-tables: %s:5: key 'modes[0].median_radius_um': expected a number from 1e-04 to 100 in um, got \".nan\"\n" % p)
         p, err = self.bad(GOOD_TYPE.replace("    basis: volume\n", "    basis: volume\n    mean_radius_um: 1\n"))
         self.assertEqual(err, "mie-tables: %s:5: unknown key 'modes[0].mean_radius_um' (did you mean 'median_radius_um'?)\n" % p)
 
@@ -250,7 +250,7 @@ class MieTablesPipeline(TempDirTestCase):
         self.write("particles/continental.yaml", text.replace("sigma_g: 2.51", "sigma_g: 0.9"))
         r = self.generate(expect=1)
         line = [i + 1 for i, l in enumerate(text.splitlines()) if "sigma_g: 2.51" in l][0]
-        self.assertEqual(r.stderr, "skybake: %s:%d: key 'modes[1].sigma_g': expected a number greater than 1, got \"0.9\"\n"
+        self.assertEqual(r.stderr, "skybake: %s:%d: key 'modes[1].sigma_g': expected a number from 1.0001 to 5, got \"0.9\"\n"
                          % (p, line))
 
 

@@ -43,7 +43,7 @@ class ProfileImportCli(CliContract, TempDirTestCase):
         out = self.path("never.exr")
         r = run([tool("profile-import"), bad, "-o", out])
         self.assertEqual(r.returncode, 1)
-        self.assertEqual(r.stderr, "profile-import: %s:2: key 'planet.radius_km': expected a positive number in km, got \"abc\"\n" % bad)
+        self.assertEqual(r.stderr, "profile-import: %s:2: key 'planet.radius_km': expected a number from 100 to 1e+05 in km, got \"abc\"\n" % bad)
         self.assertFalse(os.path.exists(out))
 
     def test_every_problem_is_reported(self):
@@ -51,8 +51,8 @@ class ProfileImportCli(CliContract, TempDirTestCase):
         r = run([tool("profile-import"), bad, "-o", self.path("x.exr")])
         self.assertEqual(r.returncode, 1)
         self.assertEqual(r.stderr.splitlines(), [
-            "profile-import: %s:2: key 'planet.radius_km': expected a positive number in km, got \"-1\"" % bad,
-            "profile-import: %s:2: missing key 'planet.top_km': expected a positive number in km" % bad,
+            "profile-import: %s:2: key 'planet.radius_km': expected a number from 100 to 1e+05 in km, got \"-1\"" % bad,
+            "profile-import: %s:2: missing key 'planet.top_km': expected a number from 1 to 1000 in km" % bad,
             "profile-import: %s:3: unknown key 'planet.topp_km' (did you mean 'top_km'?)" % bad,
             "profile-import: %s:5: key 'air.profile': expected one of 'ussa1976' or 'exponential', got \"usa1976\" (did you mean 'ussa1976'?)" % bad,
         ])

@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <thread>
@@ -38,6 +39,57 @@ TEST(FileIo, WriteIfChangedKeepsMtimeWhenEqual) {
   size_t n = 0;
   for (auto& e : fs::directory_iterator(p.parent_path())) n += e.is_regular_file();
   EXPECT_EQ(n, 1u);
+}
+
+// One transaction per command: nothing is visible before the commit, everything after it;
+// an abort leaves the old files and no temporary file.
+TEST(FileIo, TransactionRenamesTogetherOnlyAtCommit) {
+  const fs::path d = TempDir() / "tx";
+  fs::remove_all(d);
+  fs::create_directories(d);
+  WriteFileIfChanged(d / "a", "old a");
+  WriteFileIfChanged(d / "b", "old b");
+  BeginOutputTransaction();
+  EXPECT_TRUE(WriteFileIfChanged(d / "a", "new a"));
+  EXPECT_TRUE(WriteFileIfChanged(d / "b", "new b"));
+  EXPECT_TRUE(WriteFileIfChanged(d / "b", "new b"));  // staged twice: one file, the last bytes
+  EXPECT_EQ(ReadFileBytes(d / "a"), "old a");
+  EXPECT_EQ(ReadFileBytes(d / "b"), "old b");
+  EXPECT_EQ(CommitOutputTransaction(), 2u);
+  EXPECT_EQ(ReadFileBytes(d / "a"), "new a");
+  EXPECT_EQ(ReadFileBytes(d / "b"), "new b");
+  // A failed command: its staged files go, the old ones stay.
+  EXPECT_TRUE(WriteFileIfChanged(d / "a", "newer a"));
+  AbortOutputTransaction();
+  EXPECT_EQ(ReadFileBytes(d / "a"), "new a");
+  std::vector<std::string> names;
+  for (auto& e : fs::directory_iterator(d)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"a", "b"}));
+}
+
+// A run killed between its renames left a journal and one staged file; a live run's staged
+// file is never touched.
+TEST(FileIo, RecoveryCompletesDeadJournalsAndRemovesDeadTemporaries) {
+  const fs::path d = TempDir() / "recover";
+  fs::remove_all(d);
+  fs::create_directories(d);
+  const long dead = (1L << 22) + 4321;  // above the default pid_max: no such process
+  const std::string t = ".tmp-" + std::to_string(dead);
+  WriteFileIfChanged(d / "a", "new a");
+  WriteFileIfChanged(d / "b", "old b");
+  WriteFileIfChanged(d / ("b" + t), "new b");
+  WriteFileIfChanged(d / ("orphan" + t), "half");
+  const fs::path journal = d / (".skybake-commit-" + std::to_string(dead));
+  WriteFileIfChanged(journal, (d / "a").string() + "\n" + (d / "b").string() + "\n");
+  const std::string live = "live.tmp-" + std::to_string(::getpid());
+  WriteFileIfChanged(d / live, "mine");
+  RecoverOutputFolder(d);
+  EXPECT_EQ(ReadFileBytes(d / "b"), "new b");
+  std::vector<std::string> names;
+  for (auto& e : fs::directory_iterator(d)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"a", "b", live}));
 }
 
 TEST(FileIo, Depfile) {

@@ -17,9 +17,11 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 
 #include "io/error.h"
+#include "io/fileio.h"
 #include "lut/ktx2.h"
 
 using namespace skybake;
@@ -457,4 +459,13 @@ TEST(Texels, EncodeDecodeRoundTripsPerFormat) {
   // Little-endian byte order of a half: 1.0 = 0x3C00 -> bytes 00 3C.
   EXPECT_EQ(EncodeTexels(R16Sfloat(), {1.0f}), std::string("\x00\x3c", 2));
   EXPECT_THROW(EncodeTexels(B10G11R11UfloatPack32(), {0.0f, 0.0f, 0.0f}), InternalError);
+}
+
+// Found by tests/fuzz/fuzz_ktx2 (issue 22): a header whose level 0 starts past the end of a
+// truncated file was read beyond the buffer (ASan: heap-buffer-overflow) while checking
+// mipPadding; it is bad input.
+TEST(Ktx2, FileEndingBeforeItsLevelIsBadInput) {
+  const std::string bytes =
+      ReadFileBytes(std::filesystem::path(SKYBAKE_SOURCE_DIR) / "tests/fuzz/regressions/ktx2/ends_before_level0.ktx2");
+  EXPECT_THROW(DecodeKtx2(bytes, "ends_before_level0.ktx2"), InputError);
 }

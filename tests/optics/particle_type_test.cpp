@@ -151,23 +151,29 @@ TEST(ParticleType, BadInputsAreReportedWithFileAndLine) {
   };
   EXPECT_EQ(LoadErrors(dir, Type(kGoodMode)), "");
   EXPECT_EQ(with("median_radius_um: 0.12", "median_radius_um: -0.12"),
-            f + ":5: key 'modes[0].median_radius_um': expected a positive number in um, got \"-0.12\"\n");
+            f + ":5: key 'modes[0].median_radius_um': expected a number from 1e-04 to 100 in um, got \"-0.12\"\n");
   EXPECT_EQ(with("median_radius_um: 0.12", "median_radius_um: 0"),
-            f + ":5: key 'modes[0].median_radius_um': expected a positive number in um, got \"0\"\n");
+            f + ":5: key 'modes[0].median_radius_um': expected a number from 1e-04 to 100 in um, got \"0\"\n");
   EXPECT_EQ(with("r_min_um: 0.05", "r_min_um: -1"),
-            f + ":7: key 'modes[0].r_min_um': expected a positive number in um, got \"-1\"\n");
+            f + ":7: key 'modes[0].r_min_um': expected a number from 1e-04 to 100 in um, got \"-1\"\n");
   EXPECT_EQ(with("ln_sigma_g: 0.45", "ln_sigma_g: 0"),
-            f + ":6: key 'modes[0].ln_sigma_g': expected a positive number, got \"0\"\n");
+            f + ":6: key 'modes[0].ln_sigma_g': expected a number from 0.0001 to 1.609 (ln 5), got \"0\"\n");
   EXPECT_EQ(with("ln_sigma_g: 0.45", "sigma_g: 1.0"),
-            f + ":6: key 'modes[0].sigma_g': expected a number greater than 1, got \"1.0\"\n");
+            f + ":6: key 'modes[0].sigma_g': expected a number from 1.0001 to 5, got \"1.0\"\n");
   EXPECT_EQ(with("ln_sigma_g: 0.45", "sigma_g: 0.45"),
-            f + ":6: key 'modes[0].sigma_g': expected a number greater than 1, got \"0.45\"\n");
+            f + ":6: key 'modes[0].sigma_g': expected a number from 1.0001 to 5, got \"0.45\"\n");
   EXPECT_EQ(with("r_max_um: 15", "r_max_um: 0.05"),
             f + ":8: key 'modes[0].r_max_um': must be greater than r_min_um (0.05 <= 0.05)\n");
   EXPECT_EQ(with("median_radius_um: 0.12", "median_radius_um: .nan"),
-            f + ":5: key 'modes[0].median_radius_um': expected a positive number in um, got \".nan\"\n");
+            f + ":5: key 'modes[0].median_radius_um': expected a number from 1e-04 to 100 in um, got \".nan\"\n");
   EXPECT_EQ(with("r_max_um: 15", "r_max_um: nan"),
-            f + ":8: key 'modes[0].r_max_um': expected a positive number in um, got \"nan\"\n");
+            f + ":8: key 'modes[0].r_max_um': expected a number from 1e-04 to 100 in um, got \"nan\"\n");
+  // Above the stated ranges (docs/mie.md "Valid ranges"): a size parameter without end, a
+  // distribution wider than the radius range.
+  EXPECT_EQ(with("r_max_um: 15", "r_max_um: 1e20"),
+            f + ":8: key 'modes[0].r_max_um': expected a number from 1e-04 to 100 in um, got \"1e20\"\n");
+  EXPECT_EQ(with("ln_sigma_g: 0.45", "sigma_g: 1e9"),
+            f + ":6: key 'modes[0].sigma_g': expected a number from 1.0001 to 5, got \"1e9\"\n");
   EXPECT_EQ(with("basis: volume", "basis: volume\n    sigma: 2.0"),
             f + ":5: unknown key 'modes[0].sigma' (did you mean 'sigma_g'?)\n");
   EXPECT_EQ(with("ln_sigma_g: 0.45", "ln_sigma_g: 0.45\n    sigma_g: 1.5"),
@@ -208,8 +214,8 @@ TEST(ParticleType, BadRefractiveIndexTablesAreLocatedInTheCsv) {
   const std::string yaml = "refractive_index: {table: bad.csv}\nmodes:\n  - name: fine\n" + kGoodMode;
   EXPECT_EQ(LoadErrors(dir, yaml),
             csv + ":4: column 'wavelength_nm': wavelengths must increase strictly (300 after 400)\n" + csv +
-                ":4: column 'k_imag': k must be >= 0 (m = n + ik; absorbing media have k > 0), got -0.01\n" + csv +
-                ":5: column 'n_real': the real part n must be positive, got -1\n");
+                ":4: column 'k_imag': k must be from 0 to 3 (m = n + ik; absorbing media have k > 0), got -0.01\n" + csv +
+                ":5: column 'n_real': the real part n must be from 1 to 3, got -1\n");
   const std::string f = (dir.path() / "t.yaml").string();
   EXPECT_EQ(LoadErrors(dir, "refractive_index: {table: index.csv, select: {component: zz}}\nmodes:\n  - name: fine\n" +
                                 kGoodMode),

@@ -167,7 +167,7 @@ class PipelineTest(PipelineTestCase):
             ninja_before = f.read()
         self.edit("atmospheres/hazed.yaml", "column_du: 300.0", "column_du: lots")
         r = self.ninja(expect=1)
-        self.assertIn("skybake: %s:18: key 'ozone.column_du': expected a non-negative number in Dobson units, got \"lots\""
+        self.assertIn("skybake: %s:18: key 'ozone.column_du': expected a number from 0 to 1000 in Dobson units, got \"lots\""
                       % os.path.join(self.tmp, "atmospheres", "hazed.yaml"), r.stdout + r.stderr)
         after = self.mtimes()
         for k in before:

@@ -5,6 +5,7 @@
 //
 //   cumulus-map CUMULUS.yaml -o map.ktx2 [--time-s T] [--exr map.exr] [--preview map.png]
 //   cumulus-map --product coverage COVERAGE.yaml -o coverage.ktx2 [--exr ...] [--preview ...]
+#include <cmath>
 #include <filesystem>
 #include <optional>
 
@@ -150,6 +151,9 @@ int main(int argc, char** argv) {
   cli.app().add_option("--depfile", depfile, "Write a Make-style depfile listing every file read");
   return cli.Run(argc, argv, [&] {
     if (product == "coverage" && time_s) throw UsageError("--time-s applies to --product map only");
+    if (time_s && !(std::abs(*time_s) <= kMaxAbsTimeS)) {
+      throw UsageError(fmt::format("--time-s {}: expected a time in [-1e7, 1e7] s", FormatExact(*time_s)));
+    }
     // Load, validate, compute and encode every output in memory; write only when all succeeded.
     std::optional<Font> font;  // the preview's labels; missing: exit 1 before any output
     if (!preview_path.empty()) font = Font::Load();

@@ -74,7 +74,7 @@ int main(int argc, char** argv) {
                    "(docs/lut-pack.md 'Scale')")
       ->default_val("auto");
   pack->add_option("--budget-mib", budget_mib, "Fail when the sky LUTs' texels exceed this many MiB (GT7: 3.5)")
-      ->default_val(3.5)->check(CLI::PositiveNumber);
+      ->default_val(3.5)->check(CLI::Range(1e-6, 1e6));
   pack->add_option("--night-end-zenith-deg", night_end_deg, "Sun zenith angle where the sky reaches its night constant")
       ->default_val(108.0)->check(CLI::Range(100.0, 180.0));
   pack->add_option("--ocio-config", ocio_config, "OCIO config (default: $SKYBAKE_OCIO or the repo's ocio/config.ocio)");

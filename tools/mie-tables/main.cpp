@@ -65,7 +65,10 @@ std::complex<double> ParseIndex(const std::string& text) {
     im.pop_back();
     k = (im == "+" || im == "-") ? (im == "+" ? 1.0 : -1.0) : number(im);
   }
-  if (!(n > 0.0)) bad("the real part must be positive");
+  // |m| x bounds the number of series terms (Wiscombe 1980): with n, k <= 10 and x <= 1e5 at
+  // most ~1e6 terms, well under a second (docs/mie.md, "sphere").
+  if (!(n > 0.0 && n <= 10.0)) bad("the real part must be in (0, 10]");
+  if (k > 10.0) bad("the imaginary part must be at most 10");
   if (k < 0.0) {
     bad("the imaginary part must be >= 0: skybake writes m = n + ik with k >= 0 for absorbing media "
         "(MIEV0 and some tables write n - ik)");
@@ -111,7 +114,7 @@ int main(int argc, char** argv) {
   double x = 0.0;
   std::vector<double> angles_deg;
   sphere->add_option("--m", m_text, "Relative refractive index n+ki (k >= 0 absorbs), e.g. 1.33+1e-5i")->required();
-  sphere->add_option("--x", x, "Size parameter 2 pi r / lambda, > 0")->required()->check(CLI::PositiveNumber);
+  sphere->add_option("--x", x, "Size parameter 2 pi r / lambda, 1e-6 to 1e5")->required()->check(CLI::Range(1e-6, 1e5));
   sphere->add_option("--angles-deg", angles_deg, "Scattering angles in degrees for S1, S2 (comma-separated)")
       ->delimiter(',')
       ->check(CLI::Range(0.0, 180.0));

@@ -208,6 +208,7 @@ int main(int argc, char** argv) {
     }
     // Load and validate (every input file is recorded for the depfile).
     Scene s = LoadScene(scene, cli.Progress());
+    if (render->parsed() && !ro.preview.empty()) CheckPreviewOptions(s, ro);
     if (render->parsed()) {
       RenderProducts p = RenderProductsOf(s, ro, cli.Progress());
       WriteRender(s, ro, p, output, cli.name());

@@ -12,6 +12,7 @@
 #include "generator.h"
 #include "io/cli.h"
 #include "io/error.h"
+#include "io/fileio.h"
 
 namespace fs = std::filesystem;
 using namespace skybake;
@@ -58,6 +59,7 @@ int main(int argc, char** argv) {
     }
     cli.Info(std::string(r.changed ? "wrote " : "unchanged ") + r.build_ninja.string());
     if (!bake->parsed()) return;
+    CommitOutputTransaction();  // ninja reads build.ninja and the components from disk
     std::vector<std::string> args = {"ninja", "-C", r.build_ninja.parent_path().string()};
     if (jobs > 0) args.push_back("-j" + std::to_string(jobs));
     args.insert(args.end(), ninja_args.begin(), ninja_args.end());

@@ -76,6 +76,11 @@ Pipeline LoadPipeline(const fs::path& path, const std::vector<Stage*>& stages) {
       pa.file = abs;
       pa.spec = LoadAtmosphere(abs);
       pa.name = pa.spec.name;
+      if (!IsIdentifier(pa.name)) {  // a name from the file name; a 'name:' key is checked at load
+        a.Error("the atmosphere is named by its file name '" + pa.name + "', which is not " + kIdentifierExpected +
+                ": rename the file or give 'name:'");
+        continue;
+      }
       if (!pa.spec.grid) pa.spec.grid = GridSpec{p.altitude_step_m};
       if (!names.insert(pa.name).second) {
         a.Error("two atmospheres are named '" + pa.name + "'");

@@ -2,11 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <fmt/format.h>
 
 #include "io/csv.h"
+#include "io/yaml.h"
 #include "optics/rayleigh.h"
 #include "spectrum/solar.h"
 #include "spectrum/spectrum.h"
@@ -17,9 +19,9 @@ namespace {
 
 // A spectrum from two named columns: wavelength (unit from its suffix, _nm or _um) and value.
 // Errors are located at the CSV row (wavelengths must increase strictly; values >= 0 unless
-// allow_negative).
+// allow_negative; <= max_value).
 TabulatedSpectrum NamedSpectrum(const CsvTable& csv, const std::string& wavelength_column, const std::string& value_column,
-                                bool allow_negative) {
+                                bool allow_negative, double max_value = std::numeric_limits<double>::infinity()) {
   Diagnostics d;
   std::optional<CsvTable::SiColumn> wl = csv.NamedColumnIn(wavelength_column, Quantity::kWavelength, d);
   std::vector<double> values = csv.Numbers(value_column, d);
@@ -37,6 +39,9 @@ TabulatedSpectrum NamedSpectrum(const CsvTable& csv, const std::string& waveleng
     if (!allow_negative && values[r] < 0.0) {
       d.Add(csv.LocOfRow(r), fmt::format("column '{}': expected a value >= 0, got {}", value_column,
                                          csv.cell(r, csv.ColumnIndex(value_column))));
+    } else if (values[r] > max_value) {
+      d.Add(csv.LocOfRow(r), fmt::format("column '{}': expected a value from 0 to {}, got {}", value_column,
+                                         FormatExact(max_value), csv.cell(r, csv.ColumnIndex(value_column))));
     }
   }
   if (t.wavelength_nm.size() < 2) d.Add(csv.LocOfHeader(), "a spectrum needs at least 2 rows");
@@ -45,7 +50,8 @@ TabulatedSpectrum NamedSpectrum(const CsvTable& csv, const std::string& waveleng
 }
 
 // A spectral table column on the grid (spectrum/spectrum.h resampling rules).
-std::vector<double> TableOnGrid(const SpectralTableRef& ref, const WavelengthGrid& grid) {
+std::vector<double> TableOnGrid(const SpectralTableRef& ref, const WavelengthGrid& grid,
+                                double max_value = std::numeric_limits<double>::infinity()) {
   CsvTable csv = CsvTable::Load(ref.file);
   if (ref.where) {
     if (csv.ColumnIndex(ref.where->first) < 0) {
@@ -57,7 +63,7 @@ std::vector<double> TableOnGrid(const SpectralTableRef& ref, const WavelengthGri
                        fmt::format("no rows with {} = {}", ref.where->first, ref.where->second));
     }
   }
-  return Resample(NamedSpectrum(csv, ref.wavelength_column, ref.value_column, false), grid).values;
+  return Resample(NamedSpectrum(csv, ref.wavelength_column, ref.value_column, false, max_value), grid).values;
 }
 
 // Bogumil et al. (2003) ozone cross-section fit coefficients bin-averaged on the grid:
@@ -238,7 +244,7 @@ AtmosphereModel BuildAtmosphereModel(const AtmosphereSpec& spec, const VerticalP
 
   // Ground.
   if (spec.ground->albedo_table) {
-    m.ground_albedo = TableOnGrid(*spec.ground->albedo_table, grid);
+    m.ground_albedo = TableOnGrid(*spec.ground->albedo_table, grid, 1.0);  // a reflectance: [0, 1]
     if (files_read) files_read->push_back(spec.ground->albedo_table->file);
   } else {
     m.ground_albedo.assign(nw, spec.ground->albedo.value_or(0.0));

@@ -52,15 +52,21 @@ std::optional<ProfileSpec> ParseProfile(YamlNode node, const std::vector<std::st
   } else if (kind == "exponential") {
     YamlMap e = m.Map("exponential");
     ExponentialProfile p;
-    p.scale_height_m = e.Number("scale_height_km", NumberSpec::Positive("km"), 8.0) * 1e3;
-    p.base_altitude_m = e.NumberOr("base_altitude_km", NumberSpec::Any("km"), 0.0) * 1e3;
+    p.scale_height_m = e.Number("scale_height_km", NumberSpec::Range(0.1, 1000.0, "km"), 8.0) * 1e3;
+    p.base_altitude_m = e.NumberOr("base_altitude_km", NumberSpec::Range(-10.0, 100.0, "km"), 0.0) * 1e3;
+    // exp(-(z - base) / H) at the ground must stay a double (e^500 ~ 1e217).
+    if (p.base_altitude_m / p.scale_height_m > 500.0) {
+      e.node().Error(fmt::format("base_altitude_km / scale_height_km must be at most 500 (got {} km / {} km): the "
+                                 "profile would overflow at the ground",
+                                 FormatExact(p.base_altitude_m / 1e3), FormatExact(p.scale_height_m / 1e3)));
+    }
     e.Finish();
     result = p;
   } else if (kind == "tent") {
     YamlMap t = m.Map("tent");
     TentProfile p;
-    p.center_m = t.Number("center_km", NumberSpec::Any("km"), 25.0) * 1e3;
-    p.half_width_m = t.Number("half_width_km", NumberSpec::Positive("km"), 15.0) * 1e3;
+    p.center_m = t.Number("center_km", NumberSpec::Range(-10.0, 1000.0, "km"), 25.0) * 1e3;
+    p.half_width_m = t.Number("half_width_km", NumberSpec::Range(0.01, 1000.0, "km"), 15.0) * 1e3;
     t.Finish();
     result = p;
   } else if (kind == "table") {

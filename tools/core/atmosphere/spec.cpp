@@ -19,14 +19,25 @@ std::vector<double> AtmosphereSpec::AltitudeGrid() const {
 
 namespace {
 
-bool IsIdentifier(const std::string& s) {
-  if (s.empty() || !(std::islower(static_cast<unsigned char>(s[0])))) return false;
-  for (char c : s) {
-    if (!(std::islower(static_cast<unsigned char>(c)) || std::isdigit(static_cast<unsigned char>(c)) || c == '_'))
-      return false;
-  }
-  return true;
+// A positive number up to `max`.
+NumberSpec PositiveUpTo(double max, const std::string& unit) {
+  NumberSpec s = NumberSpec::Range(0.0, max, unit);
+  s.min_inclusive = false;
+  s.description = "a positive number up to " + FormatExact(max) + (unit.empty() ? "" : " in " + unit);
+  return s;
 }
+
+}  // namespace
+
+bool IsIdentifier(const std::string& s) {
+  if (s.empty() || !(s[0] >= 'a' && s[0] <= 'z')) return false;
+  for (char c : s) {
+    if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_')) return false;
+  }
+  return s.size() <= 64;
+}
+
+namespace {
 
 std::optional<SpectralTableRef> ParseSpectralTable(YamlMap m) {
   SpectralTableRef t;
@@ -76,17 +87,24 @@ AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& defau
   AtmosphereSpec spec;
   spec.file = doc.display_name();
   YamlMap root = doc.RootMap();
-  spec.name = root.OptionalString("name", "a name").value_or(default_name);
+  spec.name = default_name;
+  if (std::optional<YamlNode> name = root.Get("name")) {
+    // The name becomes a folder under outputs/ and a word of ninja command lines.
+    if (std::optional<std::string> n = name->ToString(kIdentifierExpected)) {
+      if (IsIdentifier(*n)) spec.name = *n;
+      else name->ErrorExpected(kIdentifierExpected);
+    }
+  }
 
   if (std::optional<YamlMap> planet = root.OptionalMap("planet")) {
     PlanetSpec p;
-    p.radius_m = planet->Number("radius_km", NumberSpec::Positive("km"), 6371.0) * 1e3;
-    p.top_m = planet->Number("top_km", NumberSpec::Positive("km"), 100.0) * 1e3;
+    p.radius_m = planet->Number("radius_km", NumberSpec::Range(100.0, 1e5, "km"), 6371.0) * 1e3;
+    p.top_m = planet->Number("top_km", NumberSpec::Range(1.0, 1000.0, "km"), 100.0) * 1e3;
     planet->Finish();
     spec.planet = p;
   }
   if (std::optional<YamlMap> observer = root.OptionalMap("observer")) {
-    spec.observer_altitude_m = observer->NumberOr("altitude_km", NumberSpec::NonNegative("km"), 0.0) * 1e3;
+    spec.observer_altitude_m = observer->NumberOr("altitude_km", NumberSpec::Range(0.0, 1000.0, "km"), 0.0) * 1e3;
     observer->Finish();
   }
   if (std::optional<YamlMap> grid = root.OptionalMap("grid")) {
@@ -103,7 +121,7 @@ AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& defau
       air->ErrorMissing("profile", "ussa1976 or {exponential: {...}}");
     }
     a.surface_number_density_m3 =
-        air->NumberOr("surface_number_density_m3", NumberSpec::Positive("m^-3"), a.surface_number_density_m3);
+        air->NumberOr("surface_number_density_m3", PositiveUpTo(1e28, "m^-3"), a.surface_number_density_m3);
     a.co2_ppm = air->NumberOr("co2_ppm", NumberSpec::Range(0.0, 10000.0, "ppm"), a.co2_ppm);
     air->Finish();
     spec.air = a;
@@ -115,7 +133,7 @@ AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& defau
     } else {
       ozone->ErrorMissing("profile", "{table: ...}, {tent: ...} or {exponential: ...}");
     }
-    o.column_du = ozone->OptionalNumber("column_du", NumberSpec::NonNegative("Dobson units"));
+    o.column_du = ozone->OptionalNumber("column_du", NumberSpec::Range(0.0, 1000.0, "Dobson units"));
     if (std::optional<YamlMap> xs = ozone->OptionalMap("cross_section")) {
       OzoneCrossSectionSpec c;
       std::string kind = xs->ExactlyOneOf({"table", "bogumil2003"});
@@ -150,16 +168,23 @@ AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& defau
       AerosolLayerSpec a;
       std::optional<YamlNode> name_node = layer.Get("name");
       if (!name_node) {
-        layer.ErrorMissing("name", "a lowercase identifier");
-      } else if (std::optional<std::string> name = name_node->ToString("a lowercase identifier")) {
+        layer.ErrorMissing("name", kIdentifierExpected);
+      } else if (std::optional<std::string> name = name_node->ToString(kIdentifierExpected)) {
         if (!IsIdentifier(*name)) {
-          name_node->ErrorExpected("a lowercase identifier (a-z, 0-9, _; starting with a letter)");
+          name_node->ErrorExpected(kIdentifierExpected);
         } else if (!names.insert(*name).second) {
           name_node->Error("aerosol layer name '" + *name + "' is used twice");
         }
         a.name = *name;
       }
-      a.particle = layer.OptionalPath("particle");
+      if (std::optional<YamlNode> particle = layer.Get("particle")) {
+        // A particle type is named by its file name (mie/<name>.exr).
+        a.particle = particle->ToPath();
+        if (a.particle && !IsIdentifier(a.particle->stem().string())) {
+          particle->Error("the particle type's file name '" + a.particle->stem().string() + "' is its name and must be " +
+                          kIdentifierExpected + " with .yaml");
+        }
+      }
       if (std::optional<YamlNode> prof = layer.Get("profile")) {
         if (std::optional<ProfileSpec> p = ParseProfile(*prof, {"table", "exponential", "tent"})) a.profile = *p;
       } else {
@@ -169,10 +194,10 @@ AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& defau
         std::string which = scale->ExactlyOneOf({"optical_depth_550nm", "peak_number_density_cm3"});
         if (which == "optical_depth_550nm") {
           a.scale = AerosolScale{AerosolScale::Kind::kOpticalDepth550nm,
-                                 scale->Number(which, NumberSpec::NonNegative(""), 0.0)};
+                                 scale->Number(which, NumberSpec::Range(0.0, 100.0, ""), 0.0)};
         } else if (which == "peak_number_density_cm3") {
           a.scale = AerosolScale{AerosolScale::Kind::kPeakNumberDensity,
-                                 scale->Number(which, NumberSpec::NonNegative("cm^-3"), 0.0) * 1e6};
+                                 scale->Number(which, NumberSpec::Range(0.0, 1e6, "cm^-3"), 0.0) * 1e6};
         }
         scale->Finish();
       }

@@ -123,6 +123,11 @@ struct AtmosphereSpec {
   std::vector<double> AltitudeGrid() const;
 };
 
+// Names of atmospheres, aerosol layers, particle types and modes: 1-64 characters of a-z, 0-9
+// and _, starting with a letter, so a name is a safe folder name and a plain word of a command
+// line (no '/', '.', space or quote).
+bool IsIdentifier(const std::string& s);
+inline constexpr const char* kIdentifierExpected = "a lowercase identifier (a-z, 0-9, _; starting with a letter)";
 // Loads and validates; throws InputError listing every problem with file:line.
 AtmosphereSpec LoadAtmosphere(const std::filesystem::path& path);
 AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& default_name);

@@ -5,11 +5,14 @@
 #include <tbb/global_control.h>
 
 #include <chrono>
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <mutex>
 
 #include "io/error.h"
+#include "io/fileio.h"
 #include "skybake/version.h"
 
 namespace skybake {
@@ -57,6 +60,27 @@ ProgressFn ToolCli::Progress() {
   };
 }
 
+namespace {
+
+// CLI11's numeric validators (Range, PositiveNumber, ...) compare with < and >, which a NaN
+// passes, and its double options accept "nan" and "inf": every floating-point option of the
+// parsed (sub)commands is checked here to be a finite number before the tool does any work.
+void CheckFiniteOptions(CLI::App* app) {
+  for (CLI::Option* opt : app->get_options()) {
+    if (opt->count() == 0 || opt->get_type_name().find("FLOAT") == std::string::npos) continue;
+    for (const std::string& r : opt->results()) {
+      char* end = nullptr;
+      const double v = std::strtod(r.c_str(), &end);
+      if (end != r.c_str() && !std::isfinite(v)) {
+        throw UsageError(opt->get_name() + " " + r + ": expected a finite number");
+      }
+    }
+  }
+  for (CLI::App* sub : app->get_subcommands()) CheckFiniteOptions(sub);
+}
+
+}  // namespace
+
 int ToolCli::Run(int argc, char** argv, const std::function<void()>& body) {
   // Plain stderr sink: no colours (ninja and CI logs), the tool name as prefix.
   progress_->logger = std::make_shared<spdlog::logger>(name_, std::make_shared<spdlog::sinks::stderr_sink_mt>());
@@ -72,8 +96,20 @@ int ToolCli::Run(int argc, char** argv, const std::function<void()>& body) {
     threads_control = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                             static_cast<size_t>(threads_));
   }
+  // One output transaction per command (io/fileio.h): the body's files become visible together
+  // when it succeeds, and none of them when it throws.
+  struct TransactionGuard {
+    bool done = false;
+    TransactionGuard() { BeginOutputTransaction(); }
+    ~TransactionGuard() {
+      if (!done) AbortOutputTransaction();
+    }
+  } transaction;
   try {
+    CheckFiniteOptions(&app_);
     body();
+    CommitOutputTransaction();
+    transaction.done = true;
     return 0;
   } catch (const InputError& e) {
     for (const Diagnostic& d : e.diagnostics()) std::cerr << name_ << ": " << d.ToString() << "\n";

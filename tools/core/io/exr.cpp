@@ -253,10 +253,23 @@ Imf::FrameBuffer MakeFrameBuffer(const ExrImage& img) {
 
 // Fills `img` (header attributes, channels, pixels) from a part's header; returns the frame
 // buffer to read into.
-Imf::FrameBuffer PrepareRead(const Imf::Header& h, ExrImage& img) {
+// A header whose data window holds more values than `file_bytes` can encode is refused before
+// anything is allocated: deflate (ZIP) compresses at most ~1032:1 and a value takes at least 2
+// bytes (half), so a file of n bytes holds at most ~516 n values (4096 n allowed here).
+Imf::FrameBuffer PrepareRead(const Imf::Header& h, ExrImage& img, size_t file_bytes, const std::string& name) {
   Imath::Box2i dw = h.dataWindow();
-  img.width = dw.max.x - dw.min.x + 1;
-  img.height = dw.max.y - dw.min.y + 1;
+  const int64_t w = int64_t{dw.max.x} - dw.min.x + 1, ht = int64_t{dw.max.y} - dw.min.y + 1;
+  int64_t nch_declared = 0;
+  for (auto it = h.channels().begin(); it != h.channels().end(); ++it) ++nch_declared;
+  if (w < 1 || ht < 1 || w > (int64_t{1} << 30) || ht > (int64_t{1} << 30) ||
+      static_cast<double>(w) * static_cast<double>(ht) * static_cast<double>(std::max<int64_t>(nch_declared, 1)) >
+          4096.0 * static_cast<double>(file_bytes)) {
+    throw InputError(FileLoc{name, 0}, fmt::format("not a readable OpenEXR file: a data window of {} x {} with {} "
+                                                   "channels is more than {} bytes can hold",
+                                                   w, ht, nch_declared, file_bytes));
+  }
+  img.width = static_cast<int>(w);
+  img.height = static_cast<int>(ht);
   for (auto it = h.channels().begin(); it != h.channels().end(); ++it) img.channels.push_back(it.name());
   for (auto it = h.begin(); it != h.end(); ++it) {
     const std::string key = it.name();
@@ -302,7 +315,7 @@ ExrImage DecodeExr(const std::string& bytes, const std::string& name) {
   try {
     MemIStream is(bytes, name);
     Imf::InputFile in(is, 1);
-    Imf::FrameBuffer fb = PrepareRead(in.header(), img);
+    Imf::FrameBuffer fb = PrepareRead(in.header(), img, bytes.size(), name);
     in.setFrameBuffer(fb);
     Imath::Box2i dw = in.header().dataWindow();
     in.readPixels(dw.min.y, dw.max.y);
@@ -353,7 +366,7 @@ std::vector<ExrPart> DecodeExrParts(const std::string& bytes, const std::string&
       const Imf::Header& h = in.header(i);
       p.name = h.hasName() ? h.name() : std::string();
       Imf::InputPart part(in, i);
-      Imf::FrameBuffer fb = PrepareRead(h, p.image);
+      Imf::FrameBuffer fb = PrepareRead(h, p.image, bytes.size(), name);
       part.setFrameBuffer(fb);
       Imath::Box2i dw = h.dataWindow();
       part.readPixels(dw.min.y, dw.max.y);

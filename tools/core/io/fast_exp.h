@@ -34,7 +34,10 @@ inline float ExpF(float x) {
   p = p * r + 1.0f;
   // The biased exponent clamped to 0 (the result is 0) ... 255 (inf). No float comparison here:
   // GCC turned a clamp of x into branches to the clamped constant, which stopped vectorisation.
-  const int32_t e = std::min(std::max(static_cast<int32_t>(n) + 127, int32_t{0}), int32_t{255});
+  // n is first limited to [-256, 256] (a NaN to -256), so that the conversion to int is defined for
+  // every x (NaN and |x| > 2^31 ln 2 included): the result is then 0, inf or NaN as before.
+  const float n_limited = !(n >= -256.0f) ? -256.0f : (n > 256.0f ? 256.0f : n);
+  const int32_t e = std::min(std::max(static_cast<int32_t>(n_limited) + 127, int32_t{0}), int32_t{255});
   return p * std::bit_cast<float>(e << 23);
 }
 

@@ -448,6 +448,7 @@ Texture DecodeKtx2(const std::string& bytes, const std::string& display_name) {
   if (level_offset != expected_offset)
     fail(fmt::format("level 0 byteOffset {} is not the next lcm(texel block size, 4) boundary after the key/value data ({})",
                      level_offset, expected_offset));
+  if (expected_offset > in.size()) fail(fmt::format("the file has {} bytes and ends before level 0 ({})", in.size(), expected_offset));
   for (size_t q = after_kvd; q < expected_offset; ++q) {
     if (in[q] != '\0') fail("mipPadding must be zero bytes");
   }

@@ -179,12 +179,12 @@ CumulusSpec ParseCumulusSpec(const YamlDocument& doc) {
   else w.ErrorMissing("type", "a mapping {feature_size_km, octaves, lacunarity, gain}");
   w.Finish();
 
-  std::vector<double> wind = root.NumberList("wind_m_s", NumberSpec::Any("m/s"));
+  std::vector<double> wind = root.NumberList("wind_m_s", NumberSpec::Range(-kMaxWindMS, kMaxWindMS, "m/s"));
   if (std::optional<YamlNode> n = root.Get("wind_m_s"); n && !wind.empty()) {
     if (wind.size() != 2) n->ErrorExpected("two numbers [east, north] in m/s");
     else spec.wind_m_s = {wind[0], wind[1]};
   }
-  spec.time_s = root.NumberOr("time_s", NumberSpec::Any("s"), 0.0);
+  spec.time_s = root.NumberOr("time_s", NumberSpec::Range(-kMaxAbsTimeS, kMaxAbsTimeS, "s"), 0.0);
   root.Finish();
 
   // Anti-aliasing: the finest octave's cells must span two texels where texels are largest.

@@ -106,6 +106,12 @@ class WeatherField {
   std::unique_ptr<Impl> impl_;
 };
 
+// Valid ranges (docs/clouds.md): a wind of up to 100 m/s per component (jet-stream cores
+// reach ~100 m/s) and a map time of up to 1e7 s (116 days) either side of 0, so that
+// x - wind t stays within 1e9 m, where a double still resolves 2.2e-7 m.
+inline constexpr double kMaxWindMS = 100.0;
+inline constexpr double kMaxAbsTimeS = 1e7;
+
 struct CumulusSpec {
   int resolution = 256;              // texels per side (GT7: 256)
   double size_m = 240e3;             // side of the square (GT7: 240 km)

@@ -42,12 +42,21 @@ namespace detail {
 #pragma GCC diagnostic ignored "-Wpsabi"
 typedef double V8 __attribute__((vector_size(64)));
 
+#if defined(__clang__)
+// clang (the sanitizer and fuzz build, docs/developing.md) refuses a 64-byte vector returned by a
+// function inside the avx2 clone even when it is always inlined ("changes the ABI"): there the
+// two helpers are expressions. The lanes and their operations are the same.
+typedef double V8Unaligned __attribute__((vector_size(64), aligned(8)));
+#define Load8(p) (*reinterpret_cast<const V8Unaligned*>(p))
+#define Splat8(x) (V8{(x), (x), (x), (x), (x), (x), (x), (x)})
+#else
 __attribute__((always_inline)) inline V8 Load8(const double* p) {
   V8 v;
   __builtin_memcpy(&v, p, sizeof(v));
   return v;
 }
 __attribute__((always_inline)) inline V8 Splat8(double x) { return V8{x, x, x, x, x, x, x, x}; }
+#endif
 
 // G += sum over the batch of w (x x^T + y y^T) for (x, y) = (Re, Im) of alpha (into ga) and of
 // beta (into gb), lower triangle, rows < terms. buf holds, per batch slot r, the arrays

@@ -26,6 +26,27 @@ bool IsIdentifier(const std::string& s) {
   return true;
 }
 
+// Ranges of the mode parameters (docs/mie.md, "Valid ranges"): sigma_g in [1.0001, 5] (narrower
+// is a single sphere, and the radius quadrature has no panel left; OPAC's widest
+// mode, mineral nucleation, has sigma_g = 1.95; 5 keeps the distribution inside 1e-4-100 um), a
+// weight in (0, 1e12] (number densities in cm^-3 up to 1e12 or relative values).
+NumberSpec SigmaG() {
+  NumberSpec s = NumberSpec::Range(1.0001, 5.0, "");
+  s.description = "a number from 1.0001 to 5";
+  return s;
+}
+NumberSpec LnSigmaG() {
+  NumberSpec s = NumberSpec::Range(1e-4, 1.6094379124341003, "");  // ln 5
+  s.description = "a number from 0.0001 to 1.609 (ln 5)";
+  return s;
+}
+NumberSpec Weight() {
+  NumberSpec s = NumberSpec::Range(0.0, 1e12, "");
+  s.min_inclusive = false;
+  s.description = "a positive number up to 1e12";
+  return s;
+}
+
 constexpr WeightKind kWeightKinds[] = {WeightKind::kNumberDensityCm3, WeightKind::kRelativeNumber,
                                        WeightKind::kVolumeUm3PerCm3, WeightKind::kRelativeVolume};
 
@@ -145,12 +166,12 @@ ParticleType ParseParticleType(const YamlDocument& doc, const std::string& name)
     // Centre.
     const std::string centre = m.ExactlyOneOf({"median_radius_um", "effective_radius_um"});
     if (centre == "median_radius_um") {
-      mode.median_radius_um = m.Number(centre, NumberSpec::Positive("um"), 1.0);
+      mode.median_radius_um = m.Number(centre, NumberSpec::Range(1e-4, 100.0, "um"), 1.0);
       const std::string b = m.Choice("basis", {"number", "volume"});
       if (!b.empty()) mode.basis = b == "number" ? SizeBasis::kNumber : SizeBasis::kVolume;
       if (!mode.basis) mode.basis = SizeBasis::kNumber;  // (reported above)
     } else if (centre == "effective_radius_um") {
-      mode.effective_radius_um = m.Number(centre, NumberSpec::Positive("um"), 1.0);
+      mode.effective_radius_um = m.Number(centre, NumberSpec::Range(1e-4, 100.0, "um"), 1.0);
       if (std::optional<YamlNode> b = m.Get("basis")) {
         b->Error("not used with effective_radius_um (r_eff = <r^3>/<r^2> does not depend on the basis); remove it");
       }
@@ -161,15 +182,15 @@ ParticleType ParseParticleType(const YamlDocument& doc, const std::string& name)
     const std::string width = m.ExactlyOneOf({"sigma_g", "ln_sigma_g"});
     if (width == "sigma_g") {
       mode.width_is_sigma_g = true;
-      mode.width_value = m.Number(width, NumberSpec::Above(1.0, ""), 2.0);
+      mode.width_value = m.Number(width, SigmaG(), 2.0);
     } else if (width == "ln_sigma_g") {
-      mode.width_value = m.Number(width, NumberSpec::Positive(""), 0.5);
+      mode.width_value = m.Number(width, LnSigmaG(), 0.5);
     } else {
       mode.width_value = 0.5;
     }
     // Truncation.
-    mode.r_min_um = m.Number("r_min_um", NumberSpec::Positive("um"), 0.0);
-    mode.r_max_um = m.Number("r_max_um", NumberSpec::Positive("um"), 0.0);
+    mode.r_min_um = m.Number("r_min_um", NumberSpec::Range(1e-4, 100.0, "um"), 0.0);
+    mode.r_max_um = m.Number("r_max_um", NumberSpec::Range(1e-4, 100.0, "um"), 0.0);
     if (mode.r_min_um > 0.0 && mode.r_max_um > 0.0 && !(mode.r_max_um > mode.r_min_um)) {
       m.Get("r_max_um")->Error(fmt::format("must be greater than r_min_um ({} <= {})", FormatExact(mode.r_max_um),
                                            FormatExact(mode.r_min_um)));
@@ -183,7 +204,7 @@ ParticleType ParseParticleType(const YamlDocument& doc, const std::string& name)
         for (WeightKind kind : kWeightKinds) {
           if (key != WeightKey(kind)) continue;
           mode.weight_kind = kind;
-          mode.weight = w.Number(key, NumberSpec::Positive(""), 1.0);
+          mode.weight = w.Number(key, Weight(), 1.0);
           if (!first_weight) {
             first_weight = std::make_pair(kind, mode.name);
           } else if (first_weight->first != kind) {

@@ -8,6 +8,11 @@
 
 namespace skybake::mie {
 
+// Valid refractive indices m = n + ik of aerosol material (docs/mie.md, "Valid ranges"): n from 1
+// (the medium itself) to 3 (hematite, the highest of common aerosol minerals: n ~ 3.0 in the
+// visible, Sokolik & Toon 1999), k from 0 to 3 (soot has k ~ 0.44-0.47, OPAC).
+constexpr double kMinN = 1.0, kMaxN = 3.0, kMaxK = 3.0;
+
 RefractiveIndex ParseRefractiveIndex(const YamlNode& node) {
   RefractiveIndex ri;
   ri.loc = node.loc();
@@ -29,8 +34,8 @@ RefractiveIndex ParseRefractiveIndex(const YamlNode& node) {
     ri.k_column = m.OptionalString("k_column", "a column name").value_or(ri.k_column);
   } else if (which == "n") {
     ri.kind = RefractiveIndex::Kind::kConstant;
-    ri.constant_n = m.Number("n", NumberSpec::Positive(""), 1.0);
-    ri.constant_k = m.NumberOr("k", NumberSpec::NonNegative(""), 0.0);
+    ri.constant_n = m.Number("n", NumberSpec::Range(kMinN, kMaxN, ""), 1.0);
+    ri.constant_k = m.NumberOr("k", NumberSpec::Range(0.0, kMaxK, ""), 0.0);
   }
   m.Finish();
   return ri;
@@ -65,13 +70,13 @@ void RefractiveIndex::Load() {
         diags.Add(csv.LocOfRow(r), fmt::format("column '{}': wavelengths must increase strictly ({} after {})",
                                                wl->name, csv.cell(r, c), csv.cell(r - 1, c)));
       }
-      if (std::isfinite(n[r]) && !(n[r] > 0.0)) {
-        diags.Add(csv.LocOfRow(r), fmt::format("column '{}': the real part n must be positive, got {}", n_column,
+      if (std::isfinite(n[r]) && !(n[r] >= kMinN && n[r] <= kMaxN)) {
+        diags.Add(csv.LocOfRow(r), fmt::format("column '{}': the real part n must be from 1 to 3, got {}", n_column,
                                                csv.cell(r, csv.ColumnIndex(n_column))));
       }
-      if (std::isfinite(k[r]) && k[r] < 0.0) {
+      if (std::isfinite(k[r]) && !(k[r] >= 0.0 && k[r] <= kMaxK)) {
         diags.Add(csv.LocOfRow(r),
-                  fmt::format("column '{}': k must be >= 0 (m = n + ik; absorbing media have k > 0), got {}",
+                  fmt::format("column '{}': k must be from 0 to 3 (m = n + ik; absorbing media have k > 0), got {}",
                               k_column, csv.cell(r, csv.ColumnIndex(k_column))));
       }
     }

@@ -291,6 +291,24 @@ void WriteRender(const Scene& scene, const RenderOptions& o, const RenderProduct
   WriteExrParts(path, parts);
 }
 
+void CheckPreviewOptions(const Scene& scene, const RenderOptions& o) {
+  ColorConfig config = ColorConfig::Load(scene.ocio_config);
+  const std::vector<std::string> displays = config.Displays();
+  if (std::find(displays.begin(), displays.end(), o.display) == displays.end()) {
+    throw UsageError(fmt::format("--display {}: expected one of the OCIO config's displays: {}", o.display,
+                                 fmt::join(displays, ", ")));
+  }
+  if (o.white != "auto") {
+    std::optional<double> w = ParseNumber(o.white);
+    if (!w || !(*w > 0.0 && *w <= 1e9)) {
+      throw UsageError("--white-cd-m2: expected 'auto' or a luminance in (0, 1e9] cd/m^2, got '" + o.white + "'");
+    }
+  }
+  if (!(std::abs(o.exposure_stops) <= 64.0)) {
+    throw UsageError(fmt::format("--exposure: expected stops in [-64, 64], got {}", o.exposure_stops));
+  }
+}
+
 void WriteRenderPreview(const Scene& scene, const RenderOptions& o, const RenderProducts& p, const fs::path& path) {
   ColorConfig config = ColorConfig::Load(scene.ocio_config);
   const SkyMapping& g = *p.settings.mapping;

@@ -96,5 +96,8 @@ void WriteRender(const Scene& scene, const RenderOptions& options, const RenderP
                  const std::filesystem::path& path, const std::string& tool);
 void WriteRenderPreview(const Scene& scene, const RenderOptions& options, const RenderProducts& products,
                         const std::filesystem::path& path);
+// The preview options (display of the OCIO config, white 'auto' or a luminance in
+// (0, 1e9] cd/m^2, exposure in [-64, 64] stops), checked before any rendering; UsageError.
+void CheckPreviewOptions(const Scene& scene, const RenderOptions& options);
 
 }  // namespace skybake
