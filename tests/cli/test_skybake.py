@@ -43,6 +43,16 @@ class SkybakeCli(CliContract, TempDirTestCase):
                          % self.path("pipeline.yaml"))
         self.assertFalse(os.path.exists(self.path("outputs", "build.ninja")))
 
+    def test_pools_and_launchers_as_lists_are_bad_input(self):
+        # Found by the pipeline YAML fuzz target (bench/fuzz): a list where a mapping belongs was
+        # iterated as a mapping, and yaml-cpp's InvalidNode ended the generator with exit 3.
+        for key, line in (("pools", "pools:\n-  render: 1\n"), ("launchers", "launchers:\n- sky-render: srun\n")):
+            self.write("pipeline.yaml", "atmospheres: [atmospheres/clear.yaml]\n" + line)
+            r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)
+            self.assertEqual(r.returncode, 1, r.stderr)
+            self.assertEqual(r.stderr, "skybake: %s:3: key '%s': expected a mapping, got a list\n" % (self.path("pipeline.yaml"), key))
+            self.assertFalse(os.path.exists(self.path("outputs", "build.ninja")))
+
     def test_unknown_subcommand_is_a_usage_error(self):
         r = run([tool("skybake"), "bak"])
         self.assertEqual(r.returncode, 2)

@@ -42,7 +42,10 @@ Pipeline LoadPipeline(const fs::path& path, const std::vector<Stage*>& stages) {
     wl->Finish();
   }
   if (std::optional<YamlMap> pools = root.OptionalMap("pools")) {
-    for (auto it = pools->node().raw().begin(); it != pools->node().raw().end(); ++it) {
+    // A pools value that is not a map is reported by OptionalMap (valid() false); a key that is
+    // not a plain name by Finish.
+    for (auto it = pools->node().raw().begin(); pools->valid() && it != pools->node().raw().end(); ++it) {
+      if (!it->first.IsScalar()) continue;
       std::string name = it->first.Scalar();
       if (name == "console") {
         pools->node().Error("'console' is Ninja's built-in pool and cannot be redefined");
@@ -54,7 +57,8 @@ Pipeline LoadPipeline(const fs::path& path, const std::vector<Stage*>& stages) {
   std::vector<std::string> tool_names;
   for (Stage* s : stages) tool_names.push_back(s->tool());
   if (std::optional<YamlMap> launchers = root.OptionalMap("launchers")) {
-    for (auto it = launchers->node().raw().begin(); it != launchers->node().raw().end(); ++it) {
+    for (auto it = launchers->node().raw().begin(); launchers->valid() && it != launchers->node().raw().end(); ++it) {
+      if (!it->first.IsScalar()) continue;
       std::string tool = it->first.Scalar();
       if (std::find(tool_names.begin(), tool_names.end(), tool) == tool_names.end()) continue;  // reported by Finish
       p.launchers[tool] = launchers->String(tool, "a command prefix");

@@ -23,7 +23,8 @@ RefractiveIndex ParseRefractiveIndex(const YamlNode& node) {
     ri.kind = RefractiveIndex::Kind::kTable;
     if (std::optional<std::filesystem::path> p = m.Path("table")) ri.file = *p;
     if (std::optional<YamlMap> sel = m.OptionalMap("select")) {
-      for (auto it = sel->node().raw().begin(); it != sel->node().raw().end(); ++it) {
+      for (auto it = sel->node().raw().begin(); sel->valid() && it != sel->node().raw().end(); ++it) {
+        if (!it->first.IsScalar()) continue;  // reported by Finish
         const std::string column = it->first.Scalar();
         ri.select.emplace_back(column, sel->String(column, "a cell value to match"));
       }
