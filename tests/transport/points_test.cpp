@@ -128,9 +128,8 @@ TEST(Points, PathAgreesWithOrdersWithinTheDocumentedFigures) {
 // 1.96 sqrt(sigma^2 + sigma_ref^2) against a reference of 2^16 paths with its own seed. An honest
 // 95 % interval covers in 95 % of the trials; with 150 trials the binomial standard deviation of
 // the fraction is 1.8 %, so the bound is [0.88, 0.99] (95 % - 4 sd, + 2 sd) per wavelength.
-// Measured (2026-11-25): 0.907 / 0.920 / 0.927 and 0.973 / 0.953 / 0.920 at 420 / 540 / 660 nm,
-// Y 0.967 and 0.967; the hero-first estimator (wavelength_mis = false) gave 0.887 / 0.947 /
-// 0.947 and 0.960 / 0.927 / 0.927: at these path counts the test does not tell the two apart.
+// At these path counts the bound does not separate the wavelength MIS from the hero-first
+// estimator (wavelength_mis = false): both stay inside it.
 TEST(Points, ErrorBarsCoverEveryWavelength) {
   testing::SceneOptions so;
   so.step_nm = 40.0;

@@ -69,23 +69,8 @@ clouds:
   coverage: clouds/coverage.yaml
 """
 
-# 16^3 volumes (the shipped 128^3 and 32^3 ones are tested at full size by tests/noise, tests/cli).
-SMALL_LOW = """resolution: 16
-tile_size_km: 5
-seed: 7
-format: r16_sfloat
-normalize: zero_mean
-channels:
-  - perlin_worley: {perlin: {frequency: 2, octaves: 2}, worley: {frequency: 2, weights: [0.625, 0.25, 0.125]}}
-"""
-SMALL_HIGH = """resolution: 16
-tile_size_km: 0.3
-seed: 11
-format: r8_unorm
-normalize: min_max
-channels:
-  - worley: {frequency: 2, weights: [0.625, 0.25, 0.125]}
-"""
+# 16^3 noise volumes (the shipped 128^3 and 32^3 ones are tested at full size by tests/noise, tests/cli).
+from test_clouds_pipeline import SMALL_HIGH, SMALL_LOW  # noqa: E402
 
 SKIES = ("clear", "hazed", "cloudy1", "cloudy2")
 SUN_ELEVATIONS_DEG = (60, 20, 5, 0, -4)
