@@ -38,43 +38,6 @@ class TabulatedMiePhase : public PhaseModel {
   std::vector<mie::MieTable::Bracket> brackets_;
 };
 
-// Cornette & Shanks (1992), Appl. Opt. 31, 3152, eq. 4:
-//   P(mu) = 3 (1 - g^2) (1 + mu^2) / (8 pi (2 + g^2) (1 + g^2 - 2 g mu)^{3/2}),
-// normalised to 1 over the sphere. Sampled by rejection from HG(g): P_CS / P_HG =
-// 3/2 (1 + mu^2)/(2 + g^2) <= 3/(2 + g^2) =: M (a fixed, deterministic number of uniform draws
-// is not possible with rejection, so the uniform u seeds a local stream).
-class CornetteShanksPhase : public PhaseModel {
- public:
-  explicit CornetteShanksPhase(std::vector<double> g) : g_(std::move(g)) {}
-  static double Eval(double g, double mu) {
-    const double d = 1.0 + g * g - 2.0 * g * mu;
-    return 3.0 * (1.0 - g * g) * (1.0 + mu * mu) / (8.0 * std::numbers::pi * (2.0 + g * g) * d * std::sqrt(d));
-  }
-  double Eval(size_t wl, double mu) const override { return Eval(g_[wl], mu); }
-  double SampleMu(size_t wl, double u) const override {
-    const double g = g_[wl];
-    // Deterministic rejection sampling driven by a hash chain of u (reproducible).
-    uint64_t state = static_cast<uint64_t>(u * 9007199254740992.0) ^ 0x9E3779B97F4A7C15ull;
-    auto next = [&]() {
-      state += 0x9E3779B97F4A7C15ull;
-      uint64_t z = state;
-      z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-      z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-      z ^= z >> 31;
-      return static_cast<double>(z >> 11) * 0x1.0p-53;
-    };
-    for (int i = 0; i < 1000; ++i) {
-      const double mu = HenyeyGreensteinPhase::SampleMu(g, next());
-      if (next() * 2.0 <= 1.0 + mu * mu) return mu;  // accept with (1 + mu^2)/2
-    }
-    return HenyeyGreensteinPhase::SampleMu(g, u);
-  }
-  std::string Name() const override { return "cornette-shanks"; }
-
- private:
-  std::vector<double> g_;
-};
-
 // Two-term HG: P = w HG(g1) + (1 - w) HG(g2), sampled by picking a lobe with w.
 class DualLobePhase : public PhaseModel {
  public:

@@ -1,6 +1,7 @@
 #include "atmosphere/model.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <cmath>
 #include <numbers>
 
@@ -29,6 +30,30 @@ double HenyeyGreensteinPhase::SampleMu(double g, double u) {
 
 double HenyeyGreensteinPhase::Eval(size_t wl, double mu) const { return Eval(g_[wl], mu); }
 double HenyeyGreensteinPhase::SampleMu(size_t wl, double u) const { return SampleMu(g_[wl], u); }
+
+double CornetteShanksPhase::Eval(double g, double mu) {
+  const double d = 1.0 + g * g - 2.0 * g * mu;
+  return 3.0 * (1.0 - g * g) * (1.0 + mu * mu) / (8.0 * std::numbers::pi * (2.0 + g * g) * d * std::sqrt(d));
+}
+
+double CornetteShanksPhase::SampleMu(size_t wl, double u) const {
+  const double g = g_[wl];
+  // A SplitMix64 chain seeded by u's 53 bits.
+  uint64_t state = static_cast<uint64_t>(u * 9007199254740992.0) ^ 0x9E3779B97F4A7C15ull;
+  auto next = [&]() {
+    state += 0x9E3779B97F4A7C15ull;
+    uint64_t z = state;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    z ^= z >> 31;
+    return static_cast<double>(z >> 11) * 0x1.0p-53;
+  };
+  for (int i = 0; i < 1000; ++i) {
+    const double mu = HenyeyGreensteinPhase::SampleMu(g, next());
+    if (next() * 2.0 <= 1.0 + mu * mu) return mu;  // accept with (1 + mu^2)/2
+  }
+  return HenyeyGreensteinPhase::SampleMu(g, u);
+}
 
 // ---------------------------------------------------------------------------- sun
 

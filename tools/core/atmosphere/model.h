@@ -74,6 +74,24 @@ class HenyeyGreensteinPhase : public PhaseModel {
   std::vector<double> g_;
 };
 
+// Cornette & Shanks (1992), Appl. Opt. 31, 3152, eq. 4, with asymmetry parameter g per wavelength:
+//   P(mu) = 3 (1 - g^2) (1 + mu^2) / (8 pi (2 + g^2) (1 + g^2 - 2 g mu)^{3/2}),
+// normalised to 1 over the sphere (the aerosol phase of Bruneton 2017's reference model).
+// Sampled by rejection from HG(g): P_CS / P_HG = 3/2 (1 + mu^2)/(2 + g^2) <= 3/(2 + g^2); a
+// rejection loop needs a varying number of uniforms, so the one uniform u seeds a local stream
+// (deterministic: the same u gives the same mu).
+class CornetteShanksPhase : public PhaseModel {
+ public:
+  explicit CornetteShanksPhase(std::vector<double> g) : g_(std::move(g)) {}
+  static double Eval(double g, double mu);
+  double Eval(size_t wl, double mu) const override { return Eval(g_[wl], mu); }
+  double SampleMu(size_t wl, double u) const override;
+  std::string Name() const override { return "cornette-shanks"; }
+
+ private:
+  std::vector<double> g_;
+};
+
 struct MediumComponent {
   std::string name;                          // "rayleigh", "ozone", "aerosol.<name>"
   std::shared_ptr<const PhaseModel> phase;   // null for a pure absorber

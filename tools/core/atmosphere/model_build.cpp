@@ -9,6 +9,8 @@
 
 #include "io/csv.h"
 #include "io/yaml.h"
+#include "atmosphere/parametric_optics.h"
+#include "atmosphere/table_on_grid.h"
 #include "optics/rayleigh.h"
 #include "spectrum/solar.h"
 #include "spectrum/spectrum.h"
@@ -16,55 +18,6 @@
 namespace skybake {
 
 namespace {
-
-// A spectrum from two named columns: wavelength (unit from its suffix, _nm or _um) and value.
-// Errors are located at the CSV row (wavelengths must increase strictly; values >= 0 unless
-// allow_negative; <= max_value).
-TabulatedSpectrum NamedSpectrum(const CsvTable& csv, const std::string& wavelength_column, const std::string& value_column,
-                                bool allow_negative, double max_value = std::numeric_limits<double>::infinity()) {
-  Diagnostics d;
-  std::optional<CsvTable::SiColumn> wl = csv.NamedColumnIn(wavelength_column, Quantity::kWavelength, d);
-  std::vector<double> values = csv.Numbers(value_column, d);
-  d.ThrowIfAny();
-  TabulatedSpectrum t;
-  t.display_name = csv.display_name();
-  t.source = csv.source();
-  t.quantity = value_column;
-  t.wavelength_nm = wl->values;
-  t.values = values;
-  for (size_t r = 0; r < csv.rows(); ++r) {
-    if (r > 0 && !(t.wavelength_nm[r] > t.wavelength_nm[r - 1])) {
-      d.Add(csv.LocOfRow(r), fmt::format("column '{}': wavelengths must increase strictly", wavelength_column));
-    }
-    if (!allow_negative && values[r] < 0.0) {
-      d.Add(csv.LocOfRow(r), fmt::format("column '{}': expected a value >= 0, got {}", value_column,
-                                         csv.cell(r, csv.ColumnIndex(value_column))));
-    } else if (values[r] > max_value) {
-      d.Add(csv.LocOfRow(r), fmt::format("column '{}': expected a value from 0 to {}, got {}", value_column,
-                                         FormatExact(max_value), csv.cell(r, csv.ColumnIndex(value_column))));
-    }
-  }
-  if (t.wavelength_nm.size() < 2) d.Add(csv.LocOfHeader(), "a spectrum needs at least 2 rows");
-  d.ThrowIfAny();
-  return t;
-}
-
-// A spectral table column on the grid (spectrum/spectrum.h resampling rules).
-std::vector<double> TableOnGrid(const SpectralTableRef& ref, const WavelengthGrid& grid,
-                                double max_value = std::numeric_limits<double>::infinity()) {
-  CsvTable csv = CsvTable::Load(ref.file);
-  if (ref.where) {
-    if (csv.ColumnIndex(ref.where->first) < 0) {
-      throw InputError(csv.LocOfHeader(), "no column '" + ref.where->first + "' to select rows by");
-    }
-    csv = csv.Filter(ref.where->first, ref.where->second);
-    if (csv.rows() == 0) {
-      throw InputError(FileLoc{ref.file.string(), 0},
-                       fmt::format("no rows with {} = {}", ref.where->first, ref.where->second));
-    }
-  }
-  return Resample(NamedSpectrum(csv, ref.wavelength_column, ref.value_column, false, max_value), grid).values;
-}
 
 // Bogumil et al. (2003) ozone cross-section fit coefficients bin-averaged on the grid:
 // sigma(T) = (C0 + C1 dT + C2 dT^2) 1e-20 cm^2, dT = T - 273.15 K.
@@ -100,6 +53,34 @@ OzoneFit LoadBogumil(const std::filesystem::path& file, const WavelengthGrid& gr
     }
   }
   return fit;
+}
+
+// A parametric aerosol layer: extinction at the profile's peak, k_ext(z) = k_ext,peak
+// shape(z) / max shape, split by the single-scattering albedo.
+MediumComponent ParametricAerosol(const AerosolLayerSpec& layer, const VerticalProfiles& profiles,
+                                  const WavelengthGrid& grid, std::vector<std::filesystem::path>* files_read) {
+  auto sh = std::find_if(profiles.aerosols.begin(), profiles.aerosols.end(),
+                         [&](const VerticalProfiles::Aerosol& a) { return a.name == layer.name; });
+  if (sh == profiles.aerosols.end()) {
+    throw InputError(layer.optics->extinction.where, "aerosol layer '" + layer.name + "': not in the profiles table");
+  }
+  const size_t nl = profiles.altitude_m.size(), nw = grid.size();
+  const std::vector<double> ext = CoefficientOnGrid(layer.optics->extinction, grid, files_read);
+  const std::vector<double> ssa = AlbedoOnGrid(layer.optics->single_scattering_albedo, grid, files_read);
+  const double peak = *std::max_element(sh->shape_per_m.begin(), sh->shape_per_m.end());
+  MediumComponent c;
+  c.name = "aerosol." + layer.name;
+  c.phase = PhaseOnGrid(layer.optics->phase, grid, files_read);
+  c.scattering.resize(nl * nw);
+  c.absorption.resize(nl * nw);
+  for (size_t i = 0; i < nl; ++i) {
+    const double f = peak > 0.0 ? sh->shape_per_m[i] / peak : 0.0;
+    for (size_t w = 0; w < nw; ++w) {
+      c.scattering[i * nw + w] = ext[w] * ssa[w] * f;
+      c.absorption[i * nw + w] = ext[w] * (1.0 - ssa[w]) * f;
+    }
+  }
+  return c;
 }
 
 }  // namespace
@@ -152,14 +133,27 @@ AtmosphereModel BuildAtmosphereModel(const AtmosphereSpec& spec, const VerticalP
   m.altitude_m = profiles.altitude_m;
   m.wavelength_nm = grid.wavelength_nm();
 
-  // Air: Rayleigh.
+  // Air: Rayleigh, measured (Bodhaine's cross-section per molecule) or parametric (a coefficient
+  // at the ground scaled by n(z) / n(0)).
   {
     MediumComponent c;
     c.name = "rayleigh";
     std::vector<double> gamma(nw), sigma(nw);
-    for (size_t w = 0; w < nw; ++w) {
-      sigma[w] = rayleigh::CrossSectionM2(grid[w], spec.air->co2_ppm);
-      gamma[w] = rayleigh::PhaseGamma(grid[w], spec.air->co2_ppm);
+    if (spec.air->scattering) {
+      const double n0 = profiles.air_number_density_m3.front();
+      if (!(n0 > 0.0)) throw InputError(FileLoc{spec.file.string(), 0}, "air: the number density at the ground is 0");
+      std::vector<double> beta0 = CoefficientOnGrid(*spec.air->scattering, grid, files_read);
+      // Chandrasekhar's depolarised phase: gamma = rho_n / (2 - rho_n) (optics/rayleigh.h).
+      const double g = spec.air->depolarization / (2.0 - spec.air->depolarization);
+      for (size_t w = 0; w < nw; ++w) {
+        sigma[w] = beta0[w] / n0;
+        gamma[w] = g;
+      }
+    } else {
+      for (size_t w = 0; w < nw; ++w) {
+        sigma[w] = rayleigh::CrossSectionM2(grid[w], spec.air->co2_ppm);
+        gamma[w] = rayleigh::PhaseGamma(grid[w], spec.air->co2_ppm);
+      }
     }
     c.phase = std::make_shared<RayleighPhase>(gamma);
     c.scattering.resize(nl * nw);
@@ -207,6 +201,10 @@ AtmosphereModel BuildAtmosphereModel(const AtmosphereSpec& spec, const VerticalP
   // Aerosols.
   if (options.aerosols) {
     for (const AerosolLayerSpec& layer : spec.aerosols) {
+      if (layer.optics) {
+        m.components.push_back(ParametricAerosol(layer, profiles, grid, files_read));
+        continue;
+      }
       auto it = std::find_if(aerosols.begin(), aerosols.end(), [&](const AerosolOptics& a) { return a.layer == layer.name; });
       if (it == aerosols.end()) {
         throw InputError(FileLoc{spec.file.string(), 0}, "aerosol layer '" + layer.name + "': no Mie table was given for it");
@@ -242,6 +240,29 @@ AtmosphereModel BuildAtmosphereModel(const AtmosphereSpec& spec, const VerticalP
     }
   }
 
+  // Absorbing layers (part of the ozone-like absorption the options switch off with ozone: both
+  // are the stratospheric absorbers of the peers' models).
+  if (options.ozone) {
+    for (const AbsorberSpec& layer : spec.absorbers) {
+      auto sh = std::find_if(profiles.absorbers.begin(), profiles.absorbers.end(),
+                             [&](const VerticalProfiles::Aerosol& a) { return a.name == layer.name; });
+      if (sh == profiles.absorbers.end()) {
+        throw InputError(FileLoc{spec.file.string(), 0}, "absorbing layer '" + layer.name + "': not in the profiles table");
+      }
+      const std::vector<double> k = CoefficientOnGrid(layer.absorption, grid, files_read);
+      const double peak = *std::max_element(sh->shape_per_m.begin(), sh->shape_per_m.end());
+      MediumComponent c;
+      c.name = "absorber." + layer.name;
+      c.scattering.assign(nl * nw, 0.0);
+      c.absorption.resize(nl * nw);
+      for (size_t i = 0; i < nl; ++i) {
+        const double f = peak > 0.0 ? sh->shape_per_m[i] / peak : 0.0;
+        for (size_t w = 0; w < nw; ++w) c.absorption[i * nw + w] = k[w] * f;
+      }
+      m.components.push_back(std::move(c));
+    }
+  }
+
   // Ground.
   if (spec.ground->albedo_table) {
     m.ground_albedo = TableOnGrid(*spec.ground->albedo_table, grid, 1.0);  // a reflectance: [0, 1]
@@ -254,8 +275,12 @@ AtmosphereModel BuildAtmosphereModel(const AtmosphereSpec& spec, const VerticalP
   }
 
   // Sun.
-  m.sun.irradiance = TableOnGrid(spec.sun->spectrum, grid);
-  if (files_read) files_read->push_back(spec.sun->spectrum.file);
+  if (spec.sun->constant_w_m2_nm) {
+    m.sun.irradiance.assign(nw, *spec.sun->constant_w_m2_nm);
+  } else {
+    m.sun.irradiance = TableOnGrid(spec.sun->spectrum, grid);
+    if (files_read) files_read->push_back(spec.sun->spectrum.file);
+  }
   m.sun.angular_radius_rad = spec.sun->angular_diameter_deg / 2.0 * std::numbers::pi / 180.0;
   if (spec.sun->limb_darkening_file) {
     m.sun.limb_coefficients = LoadLimbDarkening(*spec.sun->limb_darkening_file, grid);

@@ -16,7 +16,7 @@ std::string ProfileKind(const ProfileSpec& spec) {
   return std::visit(V{}, spec);
 }
 
-std::optional<ProfileSpec> ParseProfile(YamlNode node, const std::vector<std::string>& allowed) {
+std::optional<ProfileSpec> ParseProfile(YamlNode node, const std::vector<std::string>& allowed, bool air) {
   std::string expected = "a mapping with one of";
   for (const auto& a : allowed) expected += " '" + a + "'";
   // "profile: ussa1976" is accepted as a shorthand for {ussa1976: {}}.
@@ -79,6 +79,11 @@ std::optional<ProfileSpec> ParseProfile(YamlNode node, const std::vector<std::st
     p.interpolation = interp == "linear" ? Interpolation::kLinear : Interpolation::kLogLinear;
     std::string outside = t.ChoiceOr("outside", {"error", "zero"}, "error");
     p.zero_outside = outside == "zero";
+    if (air) {
+      // Air needs its temperature (ozone cross-sections, the isothermal fits) and an absolute density.
+      p.temperature_column = t.String("temperature_column", "a column name such as temperature_K");
+      if (p.zero_outside) t.node().Error("an air table must cover the whole atmosphere: 'outside: zero' is not allowed");
+    }
     t.Finish();
     if (file) {
       p.file = *file;
@@ -112,6 +117,7 @@ void EmitProfile(YAML::Emitter& out, const ProfileSpec& spec, const std::filesys
     out << YAML::Key << "interpolation" << YAML::Value
         << (tb->interpolation == Interpolation::kLinear ? "linear" : "log");
     out << YAML::Key << "outside" << YAML::Value << (tb->zero_outside ? "zero" : "error");
+    if (!tb->temperature_column.empty()) out << YAML::Key << "temperature_column" << YAML::Value << tb->temperature_column;
     out << YAML::EndMap;
   }
   out << YAML::EndMap;

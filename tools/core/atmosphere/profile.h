@@ -41,13 +41,16 @@ struct TableProfile {
   std::string value_column;     // e.g. "extinction_550nm_per_km"
   Interpolation interpolation = Interpolation::kLogLinear;
   bool zero_outside = false;    // values outside the table are 0 instead of an error
+  // Air tables only: the temperature column (unit _K) beside the number density.
+  std::string temperature_column;
 };
 
 using ProfileSpec = std::variant<Ussa1976Profile, ExponentialProfile, TentProfile, TableProfile>;
 
 // Reads a profile mapping ({ussa1976: {}}, {exponential: {...}}, {tent: {...}}, {table: {...}}),
 // reporting problems to the document's diagnostics. `allowed` lists the kinds accepted here.
-std::optional<ProfileSpec> ParseProfile(YamlNode node, const std::vector<std::string>& allowed);
+// `air`: a table may (and must) name its temperature_column and its value column is a number density.
+std::optional<ProfileSpec> ParseProfile(YamlNode node, const std::vector<std::string>& allowed, bool air = false);
 
 // Writes the canonical YAML form (paths relative to `base_dir`) into an emitter.
 void EmitProfile(YAML::Emitter& out, const ProfileSpec& spec, const std::filesystem::path& base_dir);

@@ -39,38 +39,20 @@ bool IsIdentifier(const std::string& s) {
 
 namespace {
 
-std::optional<SpectralTableRef> ParseSpectralTable(YamlMap m) {
-  SpectralTableRef t;
-  std::optional<std::filesystem::path> file = m.Path("file");
-  t.wavelength_column = m.String("wavelength_column", "a column name such as wavelength_nm");
-  t.value_column = m.String("value_column", "a column name");
-  if (std::optional<YamlMap> where = m.OptionalMap("where")) {
-    YAML::Node raw = where->node().raw();
-    if (raw.size() != 1) {
-      where->node().Error("expected exactly one 'column: value' pair");
-    } else {
-      auto it = raw.begin();
-      std::string col = it->first.Scalar();
-      t.where = std::make_pair(col, where->String(col, "a cell value"));
-    }
-    where->Finish();
+// The absorbers section (both components: a layer without its coefficient would not parse).
+void EmitAbsorbers(YAML::Emitter& out, const AtmosphereSpec& spec, const std::filesystem::path& dir) {
+  if (spec.absorbers.empty()) return;
+  out << YAML::Key << "absorbers" << YAML::Value << YAML::BeginSeq;
+  for (const AbsorberSpec& a : spec.absorbers) {
+    out << YAML::BeginMap;
+    out << YAML::Key << "name" << YAML::Value << a.name;
+    out << YAML::Key << "absorption" << YAML::Value;
+    EmitCoefficientSpectrum(out, a.absorption, dir);
+    out << YAML::Key << "profile" << YAML::Value;
+    EmitProfile(out, a.profile, dir);
+    out << YAML::EndMap;
   }
-  m.Finish();
-  if (!file) return std::nullopt;
-  t.file = *file;
-  return t;
-}
-
-void EmitSpectralTable(YAML::Emitter& out, const SpectralTableRef& t, const std::filesystem::path& dir) {
-  out << YAML::BeginMap;
-  out << YAML::Key << "file" << YAML::Value << t.file.lexically_relative(dir).generic_string();
-  out << YAML::Key << "wavelength_column" << YAML::Value << t.wavelength_column;
-  out << YAML::Key << "value_column" << YAML::Value << t.value_column;
-  if (t.where) {
-    out << YAML::Key << "where" << YAML::Value << YAML::BeginMap << YAML::Key << t.where->first << YAML::Value
-        << t.where->second << YAML::EndMap;
-  }
-  out << YAML::EndMap;
+  out << YAML::EndSeq;
 }
 
 void EmitPlanet(YAML::Emitter& out, const AtmosphereSpec& spec) {
@@ -116,13 +98,26 @@ AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& defau
   if (std::optional<YamlMap> air = root.OptionalMap("air")) {
     AirSpec a;
     if (std::optional<YamlNode> prof = air->Get("profile")) {
-      if (std::optional<ProfileSpec> p = ParseProfile(*prof, {"ussa1976", "exponential"})) a.profile = *p;
+      if (std::optional<ProfileSpec> p = ParseProfile(*prof, {"ussa1976", "exponential", "table"}, true)) a.profile = *p;
     } else {
-      air->ErrorMissing("profile", "ussa1976 or {exponential: {...}}");
+      air->ErrorMissing("profile", "ussa1976, {exponential: {...}} or {table: {...}}");
     }
     a.surface_number_density_m3 =
         air->NumberOr("surface_number_density_m3", PositiveUpTo(1e28, "m^-3"), a.surface_number_density_m3);
-    a.co2_ppm = air->NumberOr("co2_ppm", NumberSpec::Range(0.0, 10000.0, "ppm"), a.co2_ppm);
+    if (std::optional<YamlNode> sc = air->Get("scattering")) {
+      a.scattering = ParseCoefficientSpectrum(*sc);
+      if (std::optional<YamlNode> co2 = air->Get("co2_ppm")) {
+        co2->Error("co2_ppm sets the measured (Bodhaine 1999) cross-section; parametric air ('scattering') has none");
+      }
+      // rho_n < 0.5: the phase's gamma = rho / (2 - rho) must stay below 1/3 (Chandrasekhar 1950).
+      a.depolarization = air->NumberOr("depolarization", NumberSpec::Range(0.0, 0.5, "(rho_n)"), 0.0);
+    } else {
+      a.co2_ppm = air->NumberOr("co2_ppm", NumberSpec::Range(0.0, 10000.0, "ppm"), a.co2_ppm);
+      if (std::optional<YamlNode> dep = air->Get("depolarization")) {
+        dep->Error("depolarization belongs to parametric air ('scattering'); the measured cross-section carries "
+                   "Bodhaine 1999's King factor");
+      }
+    }
     air->Finish();
     spec.air = a;
   }
@@ -190,7 +185,44 @@ AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& defau
       } else {
         layer.ErrorMissing("profile", "{table: ...}, {exponential: ...} or {tent: ...}");
       }
-      if (std::optional<YamlMap> scale = layer.OptionalMap("scale")) {
+      const bool parametric = layer.Has("extinction") || layer.Has("single_scattering_albedo") || layer.Has("phase");
+      if (parametric) {
+        if (std::optional<YamlNode> particle = layer.Get("particle")) {
+          particle->Error("give either 'particle' (a measured type) or 'extinction', 'single_scattering_albedo' and "
+                          "'phase' (parametric optics), not both");
+        }
+        if (std::optional<YamlNode> scale = layer.Get("scale")) {
+          scale->Error("'scale' belongs to a particle type; a parametric layer's 'extinction' is its amount");
+        }
+        ParametricAerosolOptics po;
+        bool ok = true;
+        if (std::optional<YamlNode> e = layer.Get("extinction")) {
+          std::optional<CoefficientSpectrum> c = ParseCoefficientSpectrum(*e);
+          ok = ok && c.has_value();
+          if (c) po.extinction = *c;
+        } else {
+          layer.ErrorMissing("extinction", "a coefficient spectrum such as {per_m: 4.44e-6}");
+          ok = false;
+        }
+        if (std::optional<YamlNode> w = layer.Get("single_scattering_albedo")) {
+          std::optional<AlbedoSpectrum> c = ParseAlbedoSpectrum(*w);
+          ok = ok && c.has_value();
+          if (c) po.single_scattering_albedo = *c;
+        } else {
+          layer.ErrorMissing("single_scattering_albedo", "a number from 0 to 1 (or {rgb: [...]} or {table: {...}})");
+          ok = false;
+        }
+        if (std::optional<YamlNode> ph = layer.Get("phase")) {
+          std::optional<PhaseSpec> c = ParsePhaseSpec(*ph);
+          ok = ok && c.has_value();
+          if (c) po.phase = *c;
+        } else {
+          layer.ErrorMissing("phase", "{henyey_greenstein: {g: ...}}, {cornette_shanks: {g: ...}} or {table: {...}}");
+          ok = false;
+        }
+        if (ok) a.optics = po;
+      }
+      if (std::optional<YamlMap> scale = parametric ? std::nullopt : layer.OptionalMap("scale")) {
         std::string which = scale->ExactlyOneOf({"optical_depth_550nm", "peak_number_density_cm3"});
         if (which == "optical_depth_550nm") {
           a.scale = AerosolScale{AerosolScale::Kind::kOpticalDepth550nm,
@@ -203,6 +235,37 @@ AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& defau
       }
       layer.Finish();
       spec.aerosols.push_back(std::move(a));
+    }
+  }
+  if (std::optional<std::vector<YamlNode>> layers = root.OptionalSeq("absorbers")) {
+    std::set<std::string> names;
+    for (const YamlNode& layer_node : *layers) {
+      YamlMap layer = layer_node.ToMap("an absorbing layer (a mapping)");
+      if (!layer.valid()) continue;
+      AbsorberSpec a;
+      std::optional<YamlNode> name_node = layer.Get("name");
+      if (!name_node) {
+        layer.ErrorMissing("name", kIdentifierExpected);
+      } else if (std::optional<std::string> name = name_node->ToString(kIdentifierExpected)) {
+        if (!IsIdentifier(*name)) {
+          name_node->ErrorExpected(kIdentifierExpected);
+        } else if (!names.insert(*name).second) {
+          name_node->Error("absorbing layer name '" + *name + "' is used twice");
+        }
+        a.name = *name;
+      }
+      if (std::optional<YamlNode> c = layer.Get("absorption")) {
+        if (std::optional<CoefficientSpectrum> cs = ParseCoefficientSpectrum(*c)) a.absorption = *cs;
+      } else {
+        layer.ErrorMissing("absorption", "a coefficient spectrum such as {rgb_per_km: [6.5e-4, 1.881e-3, 8.5e-5]}");
+      }
+      if (std::optional<YamlNode> prof = layer.Get("profile")) {
+        if (std::optional<ProfileSpec> p = ParseProfile(*prof, {"table", "exponential", "tent"})) a.profile = *p;
+      } else {
+        layer.ErrorMissing("profile", "{table: ...}, {exponential: ...} or {tent: ...}");
+      }
+      layer.Finish();
+      spec.absorbers.push_back(std::move(a));
     }
   }
   if (std::optional<YamlMap> ground = root.OptionalMap("ground")) {
@@ -221,7 +284,13 @@ AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& defau
   }
   if (std::optional<YamlMap> sun = root.OptionalMap("sun")) {
     SunSpec s;
-    if (auto t = ParseSpectralTable(sun->Map("spectrum"))) s.spectrum = *t;
+    YamlMap spectrum = sun->Map("spectrum");
+    if (spectrum.valid() && spectrum.Has("constant_W_m2_nm")) {
+      s.constant_w_m2_nm = spectrum.Number("constant_W_m2_nm", PositiveUpTo(1000.0, "W m^-2 nm^-1"), 1.0);
+      spectrum.Finish();
+    } else if (auto t = ParseSpectralTable(spectrum)) {
+      s.spectrum = *t;
+    }
     s.angular_diameter_deg = sun->NumberOr("angular_diameter_deg", NumberSpec::Range(0.01, 20.0, "degrees"), s.angular_diameter_deg);
     if (std::optional<YamlNode> ld = sun->Get("limb_darkening")) {
       if (ld->IsScalar() && ld->raw().Scalar() == "none") {
@@ -300,6 +369,7 @@ std::string CanonicalProfilesYaml(const AtmosphereSpec& spec, const std::filesys
     }
     out << YAML::EndSeq;
   }
+  EmitAbsorbers(out, spec, dir);
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }
@@ -320,7 +390,13 @@ std::string CanonicalRenderYaml(const AtmosphereSpec& spec, const std::filesyste
     out << YAML::Key << "air" << YAML::Value << YAML::BeginMap;
     out << YAML::Key << "profile" << YAML::Value;
     EmitProfile(out, spec.air->profile, dir);  // kind only matters for provenance; densities come from profiles.exr
-    out << YAML::Key << "co2_ppm" << YAML::Value << FormatExact(spec.air->co2_ppm);
+    if (spec.air->scattering) {
+      out << YAML::Key << "scattering" << YAML::Value;
+      EmitCoefficientSpectrum(out, *spec.air->scattering, dir);
+      out << YAML::Key << "depolarization" << YAML::Value << FormatExact(spec.air->depolarization);
+    } else {
+      out << YAML::Key << "co2_ppm" << YAML::Value << FormatExact(spec.air->co2_ppm);
+    }
     out << YAML::EndMap;
   }
   if (spec.ozone) {
@@ -352,6 +428,14 @@ std::string CanonicalRenderYaml(const AtmosphereSpec& spec, const std::filesyste
       if (a.particle) out << YAML::Key << "particle" << YAML::Value << a.particle->lexically_relative(dir).generic_string();
       out << YAML::Key << "profile" << YAML::Value;
       EmitProfile(out, a.profile, dir);
+      if (a.optics) {
+        out << YAML::Key << "extinction" << YAML::Value;
+        EmitCoefficientSpectrum(out, a.optics->extinction, dir);
+        out << YAML::Key << "single_scattering_albedo" << YAML::Value;
+        EmitAlbedoSpectrum(out, a.optics->single_scattering_albedo, dir);
+        out << YAML::Key << "phase" << YAML::Value;
+        EmitPhaseSpec(out, a.optics->phase, dir);
+      }
       if (a.scale) {
         out << YAML::Key << "scale" << YAML::Value << YAML::BeginMap;
         if (a.scale->kind == AerosolScale::Kind::kOpticalDepth550nm) {
@@ -365,6 +449,7 @@ std::string CanonicalRenderYaml(const AtmosphereSpec& spec, const std::filesyste
     }
     out << YAML::EndSeq;
   }
+  EmitAbsorbers(out, spec, dir);
   if (spec.ground) {
     out << YAML::Key << "ground" << YAML::Value << YAML::BeginMap << YAML::Key << "albedo" << YAML::Value;
     if (spec.ground->albedo_table) EmitSpectralTable(out, *spec.ground->albedo_table, dir);
@@ -374,7 +459,12 @@ std::string CanonicalRenderYaml(const AtmosphereSpec& spec, const std::filesyste
   if (spec.sun) {
     out << YAML::Key << "sun" << YAML::Value << YAML::BeginMap;
     out << YAML::Key << "spectrum" << YAML::Value;
-    EmitSpectralTable(out, spec.sun->spectrum, dir);
+    if (spec.sun->constant_w_m2_nm) {
+      out << YAML::BeginMap << YAML::Key << "constant_W_m2_nm" << YAML::Value << FormatExact(*spec.sun->constant_w_m2_nm)
+          << YAML::EndMap;
+    } else {
+      EmitSpectralTable(out, spec.sun->spectrum, dir);
+    }
     out << YAML::Key << "angular_diameter_deg" << YAML::Value << FormatExact(spec.sun->angular_diameter_deg);
     out << YAML::Key << "limb_darkening" << YAML::Value;
     if (spec.sun->limb_darkening_file) {

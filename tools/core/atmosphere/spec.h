@@ -12,7 +12,16 @@
 //       particle: ../particles/continental.yaml    # particle type (mie-tables)
 //       profile: {table: {...}} | {exponential: {...}} | {tent: {...}}
 //       scale: {optical_depth_550nm: 0.1} | {peak_number_density_cm3: 3000}
-// Later sections (ground, sun, ...) are added by the issues that use them.
+//     - name: haze                    # or given by its optics (atmosphere/optics_spec.h)
+//       extinction: {per_m: 4.44e-6}
+//       single_scattering_albedo: 0.9
+//       phase: {cornette_shanks: {g: 0.8}}
+//       profile: {exponential: {scale_height_km: 1.2}}
+//   absorbers:                        # absorption-only layers by coefficient
+//     - {name: ozone, absorption: {rgb_per_km: [...]}, profile: {tent: {...}}}
+//   ground: {albedo: 0.1}             # or a table
+//   sun: {spectrum: {file...} | {constant_W_m2_nm: 1}, angular_diameter_deg, limb_darkening}
+// Air is measured (Bodhaine's cross-section) unless it has `scattering` (the parametric form).
 //
 // A file may hold only some sections: the generator writes canonical *component* files (e.g.
 // just planet/grid/air/ozone/aerosol profiles) in this same schema, and each tool checks that
@@ -24,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "atmosphere/optics_spec.h"
 #include "atmosphere/profile.h"
 #include "io/yaml.h"
 
@@ -38,15 +48,6 @@ struct GridSpec {
   double altitude_step_m = 100.0;
 };
 
-// A spectral quantity tabulated in a CSV file: a wavelength column (unit from its suffix, _nm or
-// _um) and a value column; `where` selects rows of long-format tables (e.g. surface = grass).
-struct SpectralTableRef {
-  std::filesystem::path file;
-  std::string wavelength_column;
-  std::string value_column;
-  std::optional<std::pair<std::string, std::string>> where;  // {column, value}
-};
-
 struct AirSpec {
   ProfileSpec profile = Ussa1976Profile{};
   // CO2 mixing ratio for the Rayleigh cross-section (Bodhaine et al. 1999 eq. 19), ppm by volume.
@@ -56,6 +57,12 @@ struct AirSpec {
   // For exponential air: number density at the base altitude (m^-3). Default: USSA76 at sea
   // level, 2.54697e25 m^-3 (computed from the USSA76 constants, atmosphere/ussa1976.h).
   double surface_number_density_m3 = 2.54697e25;
+  // Parametric air (the peers' form): the Rayleigh scattering coefficient at the ground, scaled
+  // with altitude by n(z) / n(0), instead of Bodhaine's cross-section times n(z); with it the
+  // depolarisation factor rho_n of the Rayleigh phase (default 0, the pure (1 + mu^2) phase of
+  // Bruneton 2017 and Hillaire 2020).
+  std::optional<CoefficientSpectrum> scattering;
+  double depolarization = 0.0;
 };
 
 // Ozone absorption cross-section: a fixed table, or the Bogumil et al. (2003) quadratic
@@ -84,11 +91,22 @@ struct AerosolScale {
   double value = 0.0;  // optical depth (1) or peak number density (m^-3)
 };
 
+// A layer is either measured (a particle type whose Mie table gives the optics, and a scale) or
+// parametric (its optics written out; the extinction is at the profile's peak).
 struct AerosolLayerSpec {
   std::string name;
   std::optional<std::filesystem::path> particle;
   ProfileSpec profile = ExponentialProfile{};
   std::optional<AerosolScale> scale;
+  std::optional<ParametricAerosolOptics> optics;
+};
+
+// An absorption-only layer (Bruneton 2017's ozone by coefficient, Unreal's "other absorption"):
+// the absorption coefficient at the profile's peak.
+struct AbsorberSpec {
+  std::string name;
+  CoefficientSpectrum absorption;
+  ProfileSpec profile = TentProfile{};
 };
 
 // Lambertian ground: a constant spectral albedo or a table.
@@ -101,7 +119,8 @@ struct GroundSpec {
 // angular diameter, and limb darkening I(mu)/I(1) = sum_k a_k(lambda) mu^k from a table of
 // coefficients (Neckel & Labs 1994) or none (a uniform disk).
 struct SunSpec {
-  SpectralTableRef spectrum;
+  SpectralTableRef spectrum;                  // unless constant_w_m2_nm
+  std::optional<double> constant_w_m2_nm;     // a flat spectrum (W m^-2 nm^-1)
   double angular_diameter_deg = 0.5334;  // 2 x 0.2667 deg: 1 AU mean (Hillaire 2016 §4.1: 0.527-0.545 deg)
   std::optional<std::filesystem::path> limb_darkening_file;
 };
@@ -115,6 +134,7 @@ struct AtmosphereSpec {
   std::optional<AirSpec> air;
   std::optional<OzoneSpec> ozone;
   std::vector<AerosolLayerSpec> aerosols;
+  std::vector<AbsorberSpec> absorbers;
   std::optional<GroundSpec> ground;
   std::optional<SunSpec> sun;
 

@@ -34,6 +34,43 @@ VerticalProfiles ComputeProfiles(const AtmosphereSpec& spec) {
       p.air_pressure_pa[i] = s.pressure_pa;
       p.air_mass_density_kg_m3[i] = s.mass_density_kg_m3;
     }
+  } else if (const auto* tb = std::get_if<TableProfile>(&spec.air->profile)) {
+    // A measured table (e.g. an AFGL 1986 model): number density and kinetic temperature against
+    // altitude; pressure from the ideal-gas law p = n k T, mass density n M0 / NA (dry air).
+    LoadedTable density = LoadProfileTable(*tb);
+    TableProfile temperature_spec = *tb;
+    temperature_spec.value_column = tb->temperature_column;
+    temperature_spec.interpolation = Interpolation::kLinear;
+    LoadedTable temperature = LoadProfileTable(temperature_spec);
+    p.inputs_read.push_back(tb->file);
+    Diagnostics d;
+    CsvTable csv = CsvTable::Load(tb->file);
+    std::optional<CsvTable::SiColumn> nd = csv.NamedColumnIn(tb->value_column, Quantity::kNumberDensity, d);
+    std::optional<CsvTable::SiColumn> tk = csv.NamedColumnIn(tb->temperature_column, Quantity::kTemperature, d);
+    d.ThrowIfAny();
+    for (size_t r = 0; r < csv.rows(); ++r) {
+      // Air colder than 100 K or hotter than 400 K is outside every standard atmosphere (AFGL 1986:
+      // 184-300 K below 100 km); a density of 0 leaves the Rayleigh sky undefined above it.
+      if (!(tk->values[r] >= 100.0 && tk->values[r] <= 400.0)) {
+        d.Add(csv.LocOfRow(r), fmt::format("column '{}': expected a temperature from 100 to 400 K, got {}",
+                                           tb->temperature_column, csv.cell(r, csv.ColumnIndex(tb->temperature_column))));
+      }
+      if (!(nd->values[r] > 0.0)) {
+        d.Add(csv.LocOfRow(r), fmt::format("column '{}': expected a positive number density, got {}", tb->value_column,
+                                           csv.cell(r, csv.ColumnIndex(tb->value_column))));
+      }
+    }
+    d.ThrowIfAny();
+    const double unit = UnitScale(Quantity::kNumberDensity, tb->value_column.substr(tb->value_column.rfind('_') + 1)).value_or(1.0);
+    std::vector<double> n_raw = SampleShape(*tb, z, &density);
+    std::vector<double> t_raw = SampleShape(temperature_spec, z, &temperature);
+    for (size_t i = 0; i < n; ++i) {
+      const double nd_m3 = n_raw[i] * unit;
+      p.air_number_density_m3[i] = nd_m3;
+      p.air_temperature_k[i] = t_raw[i];
+      p.air_pressure_pa[i] = nd_m3 * kBoltzmann * t_raw[i];
+      p.air_mass_density_kg_m3[i] = nd_m3 * ussa1976::kM0 / ussa1976::kNA;
+    }
   } else {
     // Exponential air is an isothermal atmosphere: H = R* T / (M0 g0), so T = H M0 g0 / R*.
     const auto& e = std::get<ExponentialProfile>(spec.air->profile);
@@ -105,6 +142,29 @@ VerticalProfiles ComputeProfiles(const AtmosphereSpec& spec) {
     for (size_t i = 0; i < n; ++i) out.shape_per_m[i] = raw[i] / out.raw_column;
     p.aerosols.push_back(std::move(out));
   }
+
+  // Absorbing-layer shapes, normalised like the aerosols'.
+  for (const AbsorberSpec& a : spec.absorbers) {
+    VerticalProfiles::Aerosol out;
+    out.name = a.name;
+    std::vector<double> raw;
+    if (const auto* tb = std::get_if<TableProfile>(&a.profile)) {
+      LoadedTable table = LoadProfileTable(*tb);
+      p.inputs_read.push_back(tb->file);
+      raw = SampleShape(*tb, z, &table);
+    } else {
+      raw = SampleShape(a.profile, z, nullptr);
+    }
+    out.raw_column = Trapezoid(z, raw);
+    out.raw_peak = raw.empty() ? 0.0 : *std::max_element(raw.begin(), raw.end());
+    if (!(out.raw_column > 0.0)) {
+      throw InputError(FileLoc{spec.file.string(), 0},
+                       "absorbing layer '" + a.name + "': the profile is zero everywhere on the altitude grid");
+    }
+    out.shape_per_m.resize(n);
+    for (size_t i = 0; i < n; ++i) out.shape_per_m[i] = raw[i] / out.raw_column;
+    p.absorbers.push_back(std::move(out));
+  }
   return p;
 }
 
@@ -123,6 +183,7 @@ ExrTable ProfilesToTable(const VerticalProfiles& p) {
   add("air.mass_density", "kg m^-3", p.air_mass_density_kg_m3);
   if (p.has_ozone) add("ozone.number_density", "m^-3", p.ozone_number_density_m3);
   for (const auto& a : p.aerosols) add("aerosol." + a.name + ".shape", "m^-1", a.shape_per_m);
+  for (const auto& a : p.absorbers) add("absorber." + a.name + ".shape", "m^-1", a.shape_per_m);
   const size_t n = p.altitude_m.size();
   t.values.resize(n * cols.size());
   for (size_t i = 0; i < n; ++i) {
@@ -155,13 +216,15 @@ VerticalProfiles ProfilesFromTable(const ExrTable& t, const std::string& name) {
     p.ozone_column_du = Trapezoid(p.altitude_m, p.ozone_number_density_m3) / kDobsonUnitM2;
   }
   for (const std::string& ch : t.channels) {
-    const std::string pre = "aerosol.", post = ".shape";
-    if (ch.size() > pre.size() + post.size() && ch.compare(0, pre.size(), pre) == 0 &&
-        ch.compare(ch.size() - post.size(), post.size(), post) == 0) {
-      VerticalProfiles::Aerosol a;
-      a.name = ch.substr(pre.size(), ch.size() - pre.size() - post.size());
-      a.shape_per_m = column(ch);
-      p.aerosols.push_back(std::move(a));
+    const std::string post = ".shape";
+    for (auto [pre, list] : {std::pair{std::string("aerosol."), &p.aerosols}, std::pair{std::string("absorber."), &p.absorbers}}) {
+      if (ch.size() > pre.size() + post.size() && ch.compare(0, pre.size(), pre) == 0 &&
+          ch.compare(ch.size() - post.size(), post.size(), post) == 0) {
+        VerticalProfiles::Aerosol a;
+        a.name = ch.substr(pre.size(), ch.size() - pre.size() - post.size());
+        a.shape_per_m = column(ch);
+        list->push_back(std::move(a));
+      }
     }
   }
   return p;

@@ -1,10 +1,11 @@
 // The vertical profiles of one atmosphere on its altitude grid (what profile-import writes and
 // the renderers read):
-//   air.number_density    m^-3   US Std 1976 (or exponential, isothermal)
+//   air.number_density    m^-3   US Std 1976, exponential (isothermal) or a measured table
 //   air.temperature       K      kinetic temperature
 //   air.pressure          Pa
 //   air.mass_density      kg m^-3
 //   ozone.number_density  m^-3   rescaled to the requested column (DU)
+//   absorber.<name>.shape m^-1   an absorbing layer's profile, normalised like the aerosols'
 //   aerosol.<name>.shape  m^-1   the layer's profile normalised to a unit column:
 //                                 integral of shape dz over the grid = 1 (trapezoid rule).
 //                                 The renderer multiplies by the layer's column number
@@ -42,6 +43,7 @@ struct VerticalProfiles {
     double raw_peak = 0.0;            // max of the unscaled profile on the grid
   };
   std::vector<Aerosol> aerosols;
+  std::vector<Aerosol> absorbers;   // absorbing layers' shapes, the same normalisation
   std::vector<std::filesystem::path> inputs_read;  // data tables read (for depfiles)
 };
 

@@ -149,7 +149,9 @@ BudgetReport RunBudget(const SceneOptions& so, const BudgetOptions& o, const Pro
       }
     }
   }
-  if (!base.spec.aerosols.empty()) {
+  const bool any_mie_layer = std::any_of(base.spec.aerosols.begin(), base.spec.aerosols.end(),
+                                         [](const AerosolLayerSpec& a) { return !a.optics; });
+  if (any_mie_layer) {
     for (const char* p : {"hg", "hg-moment", "cornette-shanks", "dual-lobe"}) {
       if (so.aerosol_phase == p) continue;
       add(std::string("phase-") + p, std::string("aerosol phase ") + p + " (the Mie table's per-wavelength fit)",
@@ -160,7 +162,7 @@ BudgetReport RunBudget(const SceneOptions& so, const BudgetOptions& o, const Pro
     add("profiles-exponential", "exponential air and aerosol, tent ozone, measured columns",
         [](Simplification& s) { s.options.profiles_exponential = true; });
   }
-  if (!so.no_ozone && base.profiles.has_ozone) add("no-ozone", "ozone absorption dropped", [](Simplification& s) { s.options.no_ozone = true; });
+  if (!so.no_ozone && (base.profiles.has_ozone || !base.spec.absorbers.empty())) add("no-ozone", "ozone and absorbing layers dropped", [](Simplification& s) { s.options.no_ozone = true; });
   for (int n : {1, 2, 3, 4}) {
     add(fmt::format("orders-{}", n), fmt::format("scattering orders 1-{} ({})", n, o.method), [&](Simplification& s) { s.orders = n; });
   }

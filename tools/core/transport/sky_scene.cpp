@@ -45,6 +45,18 @@ AerosolPhase ParseAerosolPhase(const std::string& s) {
   throw UsageError("--aerosol-phase: expected mie, hg, hg-moment, cornette-shanks or dual-lobe, got '" + s + "'");
 }
 
+// The sun's spectrum as a table for the RGB grid's colour rule: its file, or a constant sun as a
+// flat table over the observers' whole support (360-830 nm).
+TabulatedSpectrum SolarSpectrumOf(const SunSpec& sun) {
+  if (!sun.constant_w_m2_nm) return LoadSpectrumColumn(sun.spectrum.file, sun.spectrum.value_column);
+  TabulatedSpectrum t;
+  t.display_name = "constant sun";
+  t.quantity = "constant_W_m2_nm";
+  t.wavelength_nm = {300.0, 1000.0};
+  t.values = {*sun.constant_w_m2_nm, *sun.constant_w_m2_nm};
+  return t;
+}
+
 std::string SliceName(double sza) { return fmt::format("sky.sza_{:06.2f}", sza); }
 
 }  // namespace
@@ -94,6 +106,7 @@ Scene LoadScene(const SceneOptions& o, const ProgressFn& progress) {
   // Aerosol optics from the Mie tables: <mie_dir>/<particle file stem>.exr.
   std::vector<AerosolOptics> aerosols;
   for (const AerosolLayerSpec& layer : s.spec.aerosols) {
+    if (layer.optics) continue;  // parametric: BuildAtmosphereModel reads its optics from the spec
     if (!layer.particle) {
       throw InputError(FileLoc{s.spec.file.string(), 0}, "aerosol layer '" + layer.name + "' has no 'particle' type");
     }
@@ -121,8 +134,7 @@ Scene LoadScene(const SceneOptions& o, const ProgressFn& progress) {
     for (size_t i = 0; i < s.grid.size(); ++i) s.xyz_weights.push_back({s.xyz->wx()[i], s.xyz->wy()[i], s.xyz->wz()[i]});
   } else {
     // The RGB grid: Bruneton's sky radiance-to-colour rule (transport/rgb_color.h).
-    s.xyz_weights = RgbGridXyzWeights(cmf, LoadSpectrumColumn(s.spec.sun->spectrum.file, s.spec.sun->spectrum.value_column),
-                                      ColorConfig::Load(s.ocio_config));
+    s.xyz_weights = RgbGridXyzWeights(cmf, SolarSpectrumOf(*s.spec.sun), ColorConfig::Load(s.ocio_config));
   }
 
   s.tracer.illumination = o.illumination == "uniform" ? Illumination::kUniform : Illumination::kSun;
