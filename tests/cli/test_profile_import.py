@@ -54,7 +54,7 @@ class ProfileImportCli(CliContract, TempDirTestCase):
             "profile-import: %s:2: key 'planet.radius_km': expected a number from 100 to 1e+05 in km, got \"-1\"" % bad,
             "profile-import: %s:2: missing key 'planet.top_km': expected a number from 1 to 1000 in km" % bad,
             "profile-import: %s:3: unknown key 'planet.topp_km' (did you mean 'top_km'?)" % bad,
-            "profile-import: %s:5: key 'air.profile': expected one of 'ussa1976' or 'exponential', got \"usa1976\" (did you mean 'ussa1976'?)" % bad,
+            "profile-import: %s:5: key 'air.profile': expected one of 'ussa1976', 'exponential' or 'table', got \"usa1976\" (did you mean 'ussa1976'?)" % bad,
         ])
 
     def test_bad_profile_table_rows_are_located(self):

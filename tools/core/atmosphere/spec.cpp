@@ -110,7 +110,9 @@ AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& defau
         co2->Error("co2_ppm sets the measured (Bodhaine 1999) cross-section; parametric air ('scattering') has none");
       }
       // rho_n < 0.5: the phase's gamma = rho / (2 - rho) must stay below 1/3 (Chandrasekhar 1950).
-      a.depolarization = air->NumberOr("depolarization", NumberSpec::Range(0.0, 0.5, "(rho_n)"), 0.0);
+      NumberSpec rho = NumberSpec::Range(0.0, 0.5, "");
+      rho.description = "a depolarisation factor rho_n from 0 to 0.5";
+      a.depolarization = air->NumberOr("depolarization", rho, 0.0);
     } else {
       a.co2_ppm = air->NumberOr("co2_ppm", NumberSpec::Range(0.0, 10000.0, "ppm"), a.co2_ppm);
       if (std::optional<YamlNode> dep = air->Get("depolarization")) {
