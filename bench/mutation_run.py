@@ -8,7 +8,9 @@ paths run on each mutant with a timeout.
 
 Per atmosphere mutant: profile-import, then sky-render render with --method single, orders
 (--quality low) and path (a few paths per texel), on 8x4 texels, one sun angle and the
-400:700:50 nm grid (Mie tables of the shipped particle types on that grid, built once).
+400:700:50 nm grid (the RGB grid for the peers' RGB atmospheres; Mie tables of the shipped
+particle types on that grid, built once). The atmospheres are those of atmospheres/,
+atmospheres/peers/ and atmospheres/afgl1986/.
 Per particle mutant: mie-tables build on the same grid.
 
 Counted per command: crashes (killed by a signal), hangs (past --timeout), internal errors
@@ -129,7 +131,9 @@ def main():
             sys.exit(f"mutation_run: the baseline Mie table of {f} failed: {err}")
 
     jobs = []
-    for sub in [args.only] if args.only else ["atmospheres", "particles"]:
+    atmosphere_folders = ["atmospheres", "atmospheres/peers", "atmospheres/afgl1986"]
+    for sub in (atmosphere_folders if args.only == "atmospheres" else [args.only]) if args.only else \
+            atmosphere_folders + ["particles"]:
         for f in sorted(os.listdir(os.path.join(work, sub))):
             if f.endswith(".yaml"):
                 for line, old, new, text in mutants(os.path.join(work, sub, f)):
@@ -139,7 +143,7 @@ def main():
         step = total / args.limit
         jobs = [jobs[int(i * step)] for i in range(args.limit)]
     print(f"mutation_run: {len(jobs)} mutants (of {total}: {len(VALUES)} values x every number of "
-          f"atmospheres/*.yaml and particles/*.yaml), timeout {args.timeout:g} s, {args.jobs} jobs", flush=True)
+          f"atmospheres/*.yaml, atmospheres/{{peers,afgl1986}}/*.yaml and particles/*.yaml), timeout {args.timeout:g} s, {args.jobs} jobs", flush=True)
 
     tally = Tally()
     sky = [b("sky-render"), "render", None, "--mie-dir", "mie", "--wavelengths", "400:700:50", "--size", "8x4",
@@ -169,6 +173,8 @@ def main():
                 out = f"{d}/sky_{method[0]}.exr"
                 cmd = sky[:]
                 cmd[2] = mutant
+                if "rgb_per_" in text:  # the peers' RGB atmospheres are rendered on the RGB grid
+                    cmd[cmd.index("--wavelengths") + 1] = "rgb"
                 rc, err, _ = run(cmd + ["-o", out, "--method"] + method, args.timeout, env_cwd)
                 results.append((f"sky-render {method[0]}", rc, err, [out]))
         os.remove(os.path.join(work, mutant))

@@ -57,9 +57,9 @@ int main(int argc, char** argv) {
         ->default_val("360:830:5");
     sub->add_option("--observer", scene.observer, "Colour-matching functions: cie2006_2deg or cie1931_2deg")
         ->default_val("cie2006_2deg");
-    sub->add_option("--aerosol-phase", scene.aerosol_phase, "Aerosol phase model: mie, hg, hg-moment, cornette-shanks, dual-lobe")
+    sub->add_option("--aerosol-phase", scene.aerosol_phase, "Phase model of the particle-type aerosol layers: mie, hg, hg-moment, cornette-shanks, dual-lobe (parametric layers keep their own)")
         ->default_val("mie");
-    sub->add_flag("--no-ozone", scene.no_ozone, "Drop ozone absorption (a simplification to measure)");
+    sub->add_flag("--no-ozone", scene.no_ozone, "Drop ozone and the absorbing layers (a simplification to measure)");
     sub->add_flag("--profiles-exponential", scene.profiles_exponential,
                   "Exponential air and aerosol profiles and a tent of ozone with the measured columns (a simplification)");
     sub->add_option("--illumination", scene.illumination, "sun, or uniform (unit radiance from space: the white furnace)")
