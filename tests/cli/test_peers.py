@@ -52,6 +52,15 @@ class PeersCli(TempDirTestCase):
             t = float(row["sun_transmittance_%dnm" % nm])
             self.assertAlmostEqual(t, math.exp(-tau), delta=2e-5 * math.exp(-tau), msg=nm)
 
+    def test_orders_states_how_many_orders_it_summed(self):
+        r = self.points(os.path.join(SRC, "atmospheres", "peers", "bruneton2017.yaml"), "360:830:10", method="orders")
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(self.path("out.csv")) as f:
+            settings = dict(l[2:].split(": ", 1) for l in f.read().splitlines()[1:] if l.startswith("# "))
+        self.assertEqual(settings["method"], "orders")
+        # Bruneton's demo sums 4 orders; a sky of optical depth ~0.3 at 440 nm needs more to converge.
+        self.assertGreaterEqual(int(settings["orders_computed"]), 4)
+
     def bad(self, old, new, wavelengths="360:830:10"):
         with open(os.path.join(SRC, "atmospheres", "peers", "bruneton2017.yaml")) as f:
             text = f.read().replace("file: ../data/", "file: %s/" % DATA)

@@ -7,6 +7,7 @@
 #include <limits>
 #include <map>
 #include <numbers>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
@@ -259,6 +260,11 @@ std::string PointsCsv(const Scene& scene, const PointsOptions& o, const PointsIn
                     "); relative_azimuth_deg = 0 looks towards the sun's azimuth; L/E0 = radiance per unit "
                     "extraterrestrial irradiance on a surface normal to the sun (sr^-1); single = the order-1 part; "
                     "sun_transmittance = from the observer to space towards the sun's centre\n";
+  // The method's resolved settings (e.g. orders_computed), one "# key: value" line each.
+  std::stringstream description(res.description);
+  for (std::string line; std::getline(description, line);) {
+    if (!line.empty()) out += "# " + line + "\n";
+  }
   out += "sun_zenith_deg,view_zenith_deg,relative_azimuth_deg";
   if (!in.altitude_column.empty()) out += ",observer_altitude_m";
   for (double w : o.wavelengths_nm) {
