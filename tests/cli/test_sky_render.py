@@ -54,7 +54,7 @@ class SkyRenderCli(CliContract, TempDirTestCase):
     def test_bad_usage(self):
         r = self.render(size="8by4")
         self.assertEqual(r.returncode, 2)
-        self.assertIn("sky-render: --size: expected WxH (2 to 8192), got '8by4'", r.stderr)
+        self.assertIn("sky-render: --size: expected WxH with sides from 2 to 8192, e.g. 64x32, got '8by4'", r.stderr)
         r = self.render("--method", "magic")
         self.assertEqual(r.returncode, 2)
         self.assertIn("sky-render: --method: expected path, ", r.stderr)

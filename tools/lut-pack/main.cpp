@@ -37,6 +37,7 @@
 #include "lut/sky_lut.h"
 #include "outputs.h"
 #include "report.h"
+#include "io/size.h"
 
 namespace fs = std::filesystem;
 using namespace skybake;
@@ -138,11 +139,9 @@ int main(int argc, char** argv) {
       if (!decode_preview.empty() && !(decode_white > 0.0 && std::isfinite(decode_white))) {
         throw UsageError("--preview needs --white-cd-m2 with a finite positive luminance");
       }
-      int w = 0, h = 0;
-      char tail = 0;
-      if (std::sscanf(decode_size.c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w < 1 || h < 1 || w > 8192 || h > 8192) {
-        throw UsageError("--size: expected WxH with 1 <= W, H <= 8192, got '" + decode_size + "'");
-      }
+      const std::optional<Size2> dome = ParseSize(decode_size, 1, 8192);
+      if (!dome) throw UsageError("--size: expected " + SizeExpected(1, 8192, "64x32") + ", got '" + decode_size + "'");
+      const int w = dome->width, h = dome->height;
       for (double z : decode_sza) {
         if (!(z >= 0.0 && z <= 180.0)) throw UsageError(fmt::format("--sun-zenith-deg: {} is not in 0-180", z));
       }

@@ -34,6 +34,7 @@
 #include "transport/points.h"
 #include "transport/sky_render.h"
 #include "transport/sky_scene.h"
+#include "io/size.h"
 
 namespace fs = std::filesystem;
 using namespace skybake;
@@ -167,10 +168,10 @@ int main(int argc, char** argv) {
   return cli.Run(argc, argv, [&] {
     if (fog->parsed()) {
       auto size = [](const std::string& text, const char* opt, int* w, int* h) {
-        char tail = 0;
-        if (std::sscanf(text.c_str(), "%dx%d%c", w, h, &tail) != 2) {
-          throw UsageError(std::string(opt) + ": expected WxH, got '" + text + "'");
-        }
+        const std::optional<Size2> s = ParseSize(text, 2, 4096);
+        if (!s) throw UsageError(std::string(opt) + ": expected " + SizeExpected(2, 4096, "32x32") + ", got '" + text + "'");
+        *w = s->width;
+        *h = s->height;
       };
       size(lut_size, "--lut-size", &fo.lut_width, &fo.lut_height);
       size(att_size, "--attenuation-size", &fo.attenuation_width, &fo.attenuation_height);

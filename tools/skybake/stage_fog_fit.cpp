@@ -29,6 +29,7 @@
 #include "atmosphere/spec.h"
 #include "paths.h"
 #include "stage.h"
+#include "io/size.h"
 
 namespace skybake {
 
@@ -154,11 +155,8 @@ class FogFitStage : public Stage {
     std::optional<YamlNode> n = m.Get(key);
     if (!n) return fallback;
     const std::optional<std::string> text = n->ToString("WxH, e.g. 32x32");
-    int w = 0, h = 0;
-    char tail = 0;
-    if (!text || std::sscanf(text->c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w < 2 || h < 2 || w > 4096 || h > 4096 ||
-        *text != fmt::format("{}x{}", w, h)) {
-      if (text) n->ErrorExpected("WxH with sides from 2 to 4096, e.g. 32x32");
+    if (!text || !ParseSize(*text, 2, 4096)) {
+      if (text) n->ErrorExpected(SizeExpected(2, 4096, "32x32"));
       return fallback;
     }
     return *text;

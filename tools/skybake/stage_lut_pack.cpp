@@ -27,6 +27,7 @@
 #include "atmosphere/spec.h"
 #include "paths.h"
 #include "stage.h"
+#include "io/size.h"
 
 namespace skybake {
 
@@ -84,11 +85,7 @@ class LutPackStage : public Stage {
       s.loc = n.loc();
       s.atmosphere = m.String("atmosphere", "the name of an atmosphere of the list above");
       const std::string size = m.String("size", "WxH, e.g. 32x128");
-      int w = 0, h = 0;
-      char tail = 0;
-      if (!size.empty() && (std::sscanf(size.c_str(), "%dx%d%c", &w, &h, &tail) != 2 || w < 2 || h < 2 || w > 4096 || h > 4096)) {
-        m.Get("size")->ErrorExpected("WxH with sides from 2 to 4096, e.g. 32x128");
-      }
+      if (!size.empty() && !ParseSize(size, 2, 4096)) m.Get("size")->ErrorExpected(SizeExpected(2, 4096, "32x128"));
       s.size = size;
       s.quality = m.ChoiceOr("quality", {"low", "medium", "high"}, quality_);
       m.Finish();

@@ -23,6 +23,7 @@
 #include "atmosphere/spec.h"
 #include "paths.h"
 #include "stage.h"
+#include "io/size.h"
 
 namespace skybake {
 
@@ -38,9 +39,8 @@ class SkyRenderStage : public Stage {
     method_ = sky->ChoiceOr("method", {"path"}, method_);
     mapping_ = sky->ChoiceOr("mapping", {"equirectangular", "fisheye"}, mapping_);
     if (std::optional<std::string> size = sky->OptionalString("size", "WxH, e.g. 32x16")) {
-      int w = 0, h = 0;
-      if (std::sscanf(size->c_str(), "%dx%d", &w, &h) != 2 || w < 2 || h < 2 || w > 8192 || h > 8192) {
-        sky->Get("size")->ErrorExpected("WxH with sides from 2 to 8192, e.g. 32x16");
+      if (!ParseSize(*size, 2, 8192)) {
+        sky->Get("size")->ErrorExpected(SizeExpected(2, 8192, "32x16"));
       } else {
         size_ = *size;
       }

@@ -23,6 +23,7 @@
 #include "optics/mie_table.h"
 #include "spectrum/spectrum.h"
 #include "transport/rgb_color.h"
+#include "io/size.h"
 
 namespace fs = std::filesystem;
 
@@ -169,10 +170,9 @@ static gt7::TimeMapping TimeMappingOf(const Scene& scene, const RenderOptions& o
 
 RenderProducts RenderProductsOf(const Scene& scene, const RenderOptions& o, const ProgressFn& progress) {
   RenderProducts p;
-  int w = 0, h = 0;
-  if (std::sscanf(o.size.c_str(), "%dx%d", &w, &h) != 2 || w < 2 || h < 2 || w > 8192 || h > 8192) {
-    throw UsageError("--size: expected WxH (2 to 8192), got '" + o.size + "'");
-  }
+  const std::optional<Size2> size = ParseSize(o.size, 2, 8192);
+  if (!size) throw UsageError("--size: expected " + SizeExpected(2, 8192, "64x32") + ", got '" + o.size + "'");
+  const int w = size->width, h = size->height;
   p.settings.mapping = MakeSkyMapping(o.mapping, w, h);
   if (!p.settings.mapping) {
     std::string names;
