@@ -1,4 +1,4 @@
-# Helpers so that a core module, a tool or a test suite is one call (style.md §14).
+# Helpers so that a core module, a tool or a test suite is one call (docs/developing.md "Layout").
 
 # Warnings for every skybake target.
 add_library(skybake_warnings INTERFACE)

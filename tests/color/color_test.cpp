@@ -81,7 +81,7 @@ TEST(OcioConfig, Cie2006MappingMatchesTheDataTables) {
   EXPECT_NEAR(build.d65_cie2006.Z, 1.07540434, 1e-8);
 }
 
-// Checked values (../shared/notes/ninja-ocio-exr-ktx.md §2.2, computed with OCIO 2.1.2 on Debian
+// Checked values (computed with OCIO 2.1.2 on Debian
 // 12): Rec.2020 (1,1,1) -> XYZ (0.950456, 1, 1.08906), i.e. the D65 white xy (0.3127, 0.3290);
 // Rec.2020 red -> (0.636958, 0.2627, 0) (ITU-R BT.2100 Table 4 Y coefficient 0.2627).
 TEST(OcioConfig, Rec2020ToXyzCheckedValues) {

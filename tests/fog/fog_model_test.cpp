@@ -1,4 +1,4 @@
-// GT7's depth model (fog/fog_model.h; ../shared/seeds/gt7-sky-talk.txt, "Global Fog
+// GT7's depth model (fog/fog_model.h; GT7 sky talk, "Global Fog
 // Approximation"): Fog = LUT(dir) (1 - exp(-a theta^p x)) / (1 - exp(-a theta^p)). Laws checked:
 // the closed-form limits (x -> 1 gives the LUT value, x -> 0 gives 0, a -> 0 gives x), the
 // derivative used by the fit against finite differences, the model being exact for a homogeneous
@@ -18,7 +18,7 @@ using namespace skybake::fog;
 
 namespace {
 constexpr double kPi = std::numbers::pi;
-// Earth (6371 km, ../shared/seeds/gt7-sky-talk.txt geometry as in docs/lut-pack.md), observer on
+// Earth (6371 km, the GT7 sky talk's geometry as in docs/lut-pack.md), observer on
 // the ground, cut at 3.5 km (docs/fog.md, "The cut").
 FogGeometry Earth() { return FogGeometry(6371e3, 0.0, 3500.0); }
 }  // namespace

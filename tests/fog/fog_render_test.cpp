@@ -1,5 +1,5 @@
 // The reference fog renders, the packed LUTs and the reference evaluator on a physical sky
-// (fog/fog_render.h, fog/fog_luts.h, fog/fog_evaluator.h; ../shared/seeds/gt7-sky-talk.txt,
+// (fog/fog_render.h, fog/fog_luts.h, fog/fog_evaluator.h; GT7 sky talk,
 // "Fog"). Laws:
 //  - consistency: at infinite depth (the low-atmosphere boundary) the fog LUT, decoded by the
 //    evaluator, equals a direct render (SkyMethod::SegmentRadiance) of the same restricted

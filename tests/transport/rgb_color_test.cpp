@@ -48,7 +48,7 @@ TEST(RgbColor, ExactForTheAssumedSpectralShape) {
 // [lambda, lambda + 10) interpolated at 680/550/440 nm) publishes
 //   SKY_SPECTRAL_RADIANCE_TO_LUMINANCE = (114974.916437, 71305.954816, 65310.548555)  (p = -3)
 //   SUN_SPECTRAL_RADIANCE_TO_LUMINANCE = (98242.786222, 69954.398112, 66475.012354)  (p = 0)
-// (../shared/notes/sky-methods.md §2.2). Ours differ by the solar normalisation (centred 10 nm
+// (atmosphere/model.cc ComputeSpectralRadianceToLuminanceFactors). Ours differ by the solar normalisation (centred 10 nm
 // bin means vs his interpolated bins) and the CMF interpolation: within 4 % (printed).
 TEST(RgbColor, CloseToBrunetonsConstants) {
   const TabulatedSpectrum solar = LoadSolarSpectrum(DefaultSolarPath());
