@@ -327,7 +327,7 @@ TEST(FogRender, AttenuationMatchesExactTransmittance) {
 // how the share of the fog near the camera changes with the elevation, which theta^p cannot
 // follow). Bounds: RMS 8 % (all), 6.5 % (near the camera), 20 % (horizon), max 70 %. The evaluator
 // on the packed LUTs adds the LUT's interpolation: measured RMS 7.40 % (all), 5.84 % (near the
-// camera), bounds 9 % and 7 % (14.1 % and 14.9 % with the global pair on texel centres before).
+// camera), bounds 9 % and 7 %.
 TEST(FogRender, ModelErrorAgainstReference) {
   const Fixture& f = Clear();
   const FogProducts& p = f.products;

@@ -1,4 +1,4 @@
-// The decode check on a physical sky (issue 6, "What must be shown"): the clear basis sky
+// The decode check on a physical sky: the clear basis sky
 // rendered by a deterministic method on the GT7 mapping at two neighbouring slices, converted
 // and packed exactly as lut-pack does (OCIO XYZ -> Linear Rec.2020, R11G11B10F), decoded by the
 // reference decoder at the sun angle half-way between the slices (in the time mapping's slice
@@ -197,8 +197,8 @@ TEST(DecodeCheck, QuadraticTimeMappingWithinTwoPercentRms) {
 TEST(DecodeCheck, DeepTwilightWithMultipleScattering) {
   // Below -1 deg the single-scattering sky is black in the Earth's shadow and its terminator
   // sweeps across the sky: a method with multiple scattering is needed for a meaningful check.
-  // The geometric time interpolation stays within 2.5 % (measured 0.8-2.3 % with `orders` of
-  // 2026-11-23; 2.3 % at slices 60-61, sun 96.9 deg, where `orders` itself interpolates its
+  // The geometric time interpolation stays within 2.5 % (measured 0.8-2.3 % with `orders`;
+  // 2.3 % at slices 60-61, sun 96.9 deg, where `orders` itself interpolates its
   // tables linearly between sun nodes 1 deg apart while the twilight sky falls ~e-fold per
   // degree: docs/sky-methods.md "Twilight"); the linear one is 15-21 % off half-way in deep
   // twilight and is printed for the record.

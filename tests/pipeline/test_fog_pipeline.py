@@ -1,4 +1,4 @@
-"""The fog-fit stage of the generated pipeline (issue 7), on a temporary copy of the repo, with a
+"""The fog-fit stage of the generated pipeline, on a temporary copy of the repo, with a
 reduced set: three basis skies (clear, hazed, cloudy2), `orders` at low quality on 7 wavelengths,
 a 4x8 fog LUT on 5 slices (gt7:3+2), an 8x8 attenuation LUT, two depth tables (sun 40 and 85 deg,
 3 elevations x 2 azimuths x 4 depths), a tiny particle type for every aerosol, no sky references.

@@ -1,4 +1,4 @@
-"""The lut-pack stage of the generated pipeline (issue 6), on a temporary copy of the repo, with a
+"""The lut-pack stage of the generated pipeline, on a temporary copy of the repo, with a
 reduced-resolution set: 4x8 (2x4 for the cloudy sky) x 5 slices (time mapping gt7:3+2), method
 `single` at low quality on 7 wavelengths, and a tiny particle type for every aerosol.
 
@@ -193,7 +193,7 @@ class LutPipelineTest(PipelineTestCase):
 
     def test_a_sky_may_name_its_own_quality(self):
         # luts.skies[i].quality overrides the section's preset for that sky's render only (the
-        # clear and hazed LUTs at `high`, which meets issue 5's accuracy target, the rest at the
+        # clear and hazed LUTs at `high`, which meets the LUT accuracy target, the rest at the
         # section's; docs/pipeline.md); a value outside low|medium|high fails at its line.
         self.edit("pipeline.yaml", "{atmosphere: hazed, size: 4x8}", "{atmosphere: hazed, size: 4x8, quality: high}")
         r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)

@@ -1,5 +1,5 @@
 // The clear basis sky rendered by the path tracer has the structure and the magnitudes of a real
-// clear sky (issue 4): blue zenith, bright horizon band, aureole, red sunset horizon, the Earth's
+// clear sky: blue zenith, bright horizon band, aureole, red sunset horizon, the Earth's
 // shadow in twilight; luminances and illuminances inside published daylight ranges.
 // Reference ranges (cited per check) are wide on purpose: they check physics, not a snapshot;
 // the measured values are printed and listed in docs/sky-render.md.
