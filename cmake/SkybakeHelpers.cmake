@@ -47,6 +47,8 @@ function(skybake_add_test_suite)
   file(GLOB _src CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/${ARG_NAME}/*_test.cpp)
   add_executable(test_${ARG_NAME} ${_src})
   target_link_libraries(test_${ARG_NAME} PRIVATE ${ARG_DEPS} GTest::gtest_main skybake_warnings)
+  # tests/support: helpers shared by the suites (support/threads.h, support/log.h).
+  target_include_directories(test_${ARG_NAME} PRIVATE ${CMAKE_SOURCE_DIR}/tests)
   target_compile_definitions(test_${ARG_NAME} PRIVATE
     SKYBAKE_SOURCE_DIR="${CMAKE_SOURCE_DIR}" SKYBAKE_BIN_DIR="${CMAKE_BINARY_DIR}/bin")
   gtest_discover_tests(test_${ARG_NAME} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS unit)

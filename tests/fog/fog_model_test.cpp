@@ -12,6 +12,7 @@
 
 #include "fog/fog_model.h"
 #include "io/error.h"
+#include "support/log.h"
 
 using namespace skybake;
 using namespace skybake::fog;
@@ -95,7 +96,7 @@ TEST(FogModel, DerivativeMatchesFiniteDifferences) {
       worst = std::max(worst, std::fabs(an - fd) / std::max(std::fabs(fd), 1e-6));
     }
   }
-  std::printf("dF/dk vs finite differences: worst relative difference %.2g\n", worst);
+  SKYBAKE_LOG("dF/dk vs finite differences: worst relative difference %.2g\n", worst);
   EXPECT_EQ(DepthFactorDk(0.0, 1.0), 0.0);
   EXPECT_EQ(DepthFactorDk(1.0, 1.0), 0.0);
 }

@@ -34,6 +34,7 @@
 #include "optics/polydisperse.h"
 #include "spectrum/cmf.h"
 #include "spectrum/xyz.h"
+#include "support/log.h"
 #include "transport/sky_method.h"
 #include "transport/sky_render.h"
 
@@ -174,7 +175,7 @@ Figures CheckPair(const std::string& time_mapping, int i, const std::string& met
   }
   f.rms = std::sqrt(e2_all / w_all);
   f.rms_outside_5deg = std::sqrt(e2_out / w_out);
-  std::printf("%s %s %s slices %2d-%2d, sun zenith %7.3f deg (%s/%s): RMS %.3f %% (%.3f %% outside 5 deg of the sun), max %+.2f %% at "
+  SKYBAKE_LOG("%s %s %s slices %2d-%2d, sun zenith %7.3f deg (%s/%s): RMS %.3f %% (%.3f %% outside 5 deg of the sun), max %+.2f %% at "
               "zenith %.1f, azimuth %.1f, %.1f deg from the sun\n",
               method.c_str(), lut::TimeInterpolationName(interp), time_mapping.c_str(), i, i + 1, tm / kDeg, gt7::SphereFamilyName(gt7::SphereMapping{}.FamilyFor(t0)),
               gt7::SphereFamilyName(gt7::SphereMapping{}.FamilyFor(t1)), 100 * f.rms, 100 * f.rms_outside_5deg, 100 * f.max,
