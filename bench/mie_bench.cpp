@@ -1,4 +1,4 @@
-// Mie tables (issue 3): what a single sphere costs as the size parameter grows, with and without
+// Mie tables: what a single sphere costs as the size parameter grows, with and without
 // the amplitudes S1, S2 on the table's 2161-angle grid, and what whole particle-type tables cost
 // on the pipeline's 95 wavelengths (360-830 nm, 5 nm) with the full phase grid, at 1 and 2 threads.
 //
@@ -6,7 +6,7 @@
 //   build/release/bin/bench_mie --benchmark_filter=Table --benchmark_repetitions=3
 // Counters: "terms" (Wiscombe's N); for tables "radii" (Mie evaluations over all
 // wavelengths), "cpu_s" (process CPU time of one build, all threads) and "wl/s" (wavelengths per
-// second of wall time). Goal (issue 3): the GT7 five-mode table in <= 5 s wall on 2 cores.
+// second of wall time). Goal: the GT7 five-mode table in <= 5 s wall on 2 cores.
 #include <benchmark/benchmark.h>
 #include <tbb/task_arena.h>
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Mutation run (issue 22): every number of the shipped atmospheres and particle types replaced,
+"""Mutation run: every number of the shipped atmospheres and particle types replaced,
 one at a time, by a huge, tiny, negative, zero, NaN or infinite value, and the tools' loading
 paths run on each mutant with a timeout.
 

@@ -1,4 +1,4 @@
-// Generation time of each cloud texture of clouds/*.yaml (issue 8), at 1 and 2 worker threads:
+// Generation time of each cloud texture of clouds/*.yaml, at 1 and 2 worker threads:
 // the GT7 low-frequency volume (128^3 Perlin-Worley), the high-frequency volume (32^3 Worley),
 // the RGBA shape volume (128^3, 4 channels), the cumulus map (256^2, including the weather
 // field's CDF calibration) and the coverage texture. Times include normalisation and texel

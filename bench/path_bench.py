@@ -7,7 +7,7 @@ Prints a table; writes only into its work folder.
                       [--size 128x32] [--sun-zenith-deg 30] [--target-error 0.01]
                       [--threads 1,2] [--work /tmp/path_bench]
 
-The defaults are issue 4's benchmark: one 32x128 sky slice (128x32 equirectangular texels, one
+The defaults are the path tracer's reference benchmark: one 32x128 sky slice (128x32 equirectangular texels, one
 sun angle) at 1 % standard error of Y per texel, clear and hazed, 1 and 2 threads (about 10 CPU
 minutes per sky and thread count on the development machine; use --size 32x8 for a quick look).
 

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Pipeline overhead benchmark (issue 2): prints the time of a no-op `ninja` on the default
+"""Pipeline overhead benchmark: prints the time of a no-op `ninja` on the default
 pipeline and the time to regenerate build.ninja.
 
   bench/pipeline_bench.py [--bin build/release/bin] [--repeat 20]

@@ -1,4 +1,4 @@
-// bench_sky_chart: the speed-vs-accuracy chart of the sky methods (issue 5, docs/sky-methods.md
+// bench_sky_chart: the speed-vs-accuracy chart of the sky methods (docs/sky-methods.md
 // "The chart"). For a fixed scene set - the clear and hazed atmospheres, sun elevations 60, 20,
 // 5, 0, -4 and -10 deg, the 91 sky directions of transport/sky_error.h - it renders
 //   - a converged path-traced reference per scene, cached under <out>/references/ in a CSV named
@@ -6,7 +6,7 @@
 //     the directions, the tracer settings and the tracer's source), so a re-run only renders
 //     what changed;
 //   - every registered deterministic method (SkyMethodNames(): whatever is registered, e.g.
-//     `orders` once it lands) at every quality (low, medium, high), timed on one thread (table
+//     `single`, `orders`) at every quality (low, medium, high), timed on one thread (table
 //     building + the 91 directions);
 //   - the path tracer itself at 10 % and 3 % target error (cached like the references; time =
 //     wall x threads, the tracer scales linearly);

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Speed of the fast deterministic sky (`orders`) on the GT7 LUT set (issue 5's speed target:
+"""Speed of the fast deterministic sky (`orders`) on the GT7 LUT set (the speed target:
 the 8 basis skies x 64 sun slices x their texels at >= 40 wavelengths in <= 60 s on 2 cores;
 docs/sky-methods.md "orders"). Prints a table; writes only into its work folder.
 
@@ -15,10 +15,10 @@ a 2x2 mapping: what does not depend on the LUT's size - the tables (the solve of
 the sun tables), the ambient LUT's 640 directions per slice and the transmittance LUT; the
 texels of 2x2x64 are negligible. The set's total at 2 threads is compared with the 60 s target, and
 the scaling 1 -> 2 threads is printed (target >= 1.8x). --size WxH renders every sky at that size
-instead of the pipeline's (32x128 for all 8: the issue's literal reading of the set; the pipeline
+instead of the pipeline's (32x128 for all 8: every sky at the clear sky's size; the pipeline
 follows the GT7 talk's memory budget, 16x64 for the cloudy skies). Each sky renders at its quality
-in pipeline.yaml (since 2026-11-24, sixth stop: high for clear and hazed, whose LUTs issue 5's
-accuracy target covers; medium for the cloudy skies); --quality Q renders every sky at Q instead
+in pipeline.yaml (high for clear and hazed, whose LUTs the LUT accuracy target
+(docs/benchmarks.md) covers; medium for the cloudy skies); --quality Q renders every sky at Q instead
 (--quality medium: the set at the quality that keeps it within 60 s; docs/benchmarks.md).
 """
 import argparse

@@ -1,4 +1,4 @@
-# Helpers so that a core module, a tool or a test suite is one call (style.md §14).
+# Helpers so that a core module, a tool or a test suite is one call (docs/developing.md "Layout").
 
 # Warnings for every skybake target.
 add_library(skybake_warnings INTERFACE)
@@ -40,14 +40,25 @@ function(skybake_add_tool)
   target_link_libraries(${ARG_NAME} PRIVATE ${ARG_DEPS} skybake_warnings)
 endfunction()
 
-# skybake_add_test_suite(NAME <suite> DEPS <targets...>)
-# tests/<suite>/*_test.cpp -> one GoogleTest binary test_<suite>, registered per test case.
+# skybake_add_test_suite(NAME <suite> DEPS <targets...> [VALIDATION <Suite.Test...>])
+# tests/<suite>/*_test.cpp -> one GoogleTest binary test_<suite>, registered per test case with the
+# label `unit`. VALIDATION names the long validation tests (over ~20 s on 2 cores, mostly against
+# the path tracer): they carry the label `validation` instead, so that `ctest -L unit` stays fast;
+# `ctest` and scripts/test without a label run both.
 function(skybake_add_test_suite)
-  cmake_parse_arguments(ARG "" "NAME" "DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "NAME" "DEPS;VALIDATION" ${ARGN})
   file(GLOB _src CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/${ARG_NAME}/*_test.cpp)
   add_executable(test_${ARG_NAME} ${_src})
   target_link_libraries(test_${ARG_NAME} PRIVATE ${ARG_DEPS} GTest::gtest_main skybake_warnings)
+  # tests/support: helpers shared by the suites (support/threads.h, support/log.h).
+  target_include_directories(test_${ARG_NAME} PRIVATE ${CMAKE_SOURCE_DIR}/tests)
   target_compile_definitions(test_${ARG_NAME} PRIVATE
     SKYBAKE_SOURCE_DIR="${CMAKE_SOURCE_DIR}" SKYBAKE_BIN_DIR="${CMAKE_BINARY_DIR}/bin")
-  gtest_discover_tests(test_${ARG_NAME} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS unit)
+  if(ARG_VALIDATION)
+    list(JOIN ARG_VALIDATION ":" _validation)
+    gtest_discover_tests(test_${ARG_NAME} DISCOVERY_TIMEOUT 60 TEST_FILTER "-${_validation}" PROPERTIES LABELS unit)
+    gtest_discover_tests(test_${ARG_NAME} DISCOVERY_TIMEOUT 60 TEST_FILTER "${_validation}" PROPERTIES LABELS validation)
+  else()
+    gtest_discover_tests(test_${ARG_NAME} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS unit)
+  endif()
 endfunction()

@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "atmosphere/simplify.h"
+#include "support/log.h"
 
 using namespace skybake;
 
@@ -74,7 +75,7 @@ TEST(Simplify, ClearAtmosphereFits) {
   std::vector<ProfileFit> fits;
   AnalyticProfiles(p, &fits);
   for (const ProfileFit& f : fits) {
-    std::printf("%s: %s, H %.0f m, n0 %.4g, centre %.0f m, half-width %.0f m, column %.4g\n", f.constituent.c_str(), f.shape.c_str(),
+    SKYBAKE_LOG("%s: %s, H %.0f m, n0 %.4g, centre %.0f m, half-width %.0f m, column %.4g\n", f.constituent.c_str(), f.shape.c_str(),
                 f.scale_height_m, f.ground_value, f.centre_m, f.half_width_m, f.column);
   }
   ASSERT_EQ(fits.size(), 3u);

@@ -14,8 +14,9 @@ double Rel(double a, double b) { return std::abs(a - b) / std::abs(b); }
 }  // namespace
 
 // Mass density at the USSA76 checkpoints 0, 11, 20, 32, 47, 51, 71, 86 km geometric.
-// Published values: USSA76 tables (NOAA-S/T 76-1562) as restated in shared/data/SOURCES.md
-// ("USSA 1976 checkpoints at geometric altitudes"), 6 significant digits; required within 1e-4.
+// Reference values: the U.S. Standard Atmosphere 1976 (NOAA-S/T 76-1562) evaluated from its
+// defining constants, 6 significant digits; they agree with the ICAO/ISO 2533 tables of
+// atmospheres/data/ussa1976_checkpoints_icao.csv to 1e-4. Required within 1e-4.
 TEST(Ussa1976, MassDensityAtPublishedCheckpoints) {
   struct Point {
     double z_km, rho;
@@ -65,7 +66,7 @@ TEST(Ussa1976, PressureAndTemperatureContinuousAcrossLayerBases) {
 }
 
 // Number density uses the kinetic temperature (M/M0 < 1 above 80 km): n(86 km) = 1.44725e20 m^-3
-// (USSA76; SOURCES.md) and n(0) = 2.54697e25 m^-3.
+// (USSA76, NOAA-S/T 76-1562, from its defining constants) and n(0) = 2.54697e25 m^-3.
 TEST(Ussa1976, NumberDensity) {
   EXPECT_LT(Rel(ussa1976::AtGeometricAltitude(0).number_density_m3, 2.54697e25), 1e-5);
   EXPECT_LT(Rel(ussa1976::AtGeometricAltitude(86000).number_density_m3, 1.44725e20), 1e-4);

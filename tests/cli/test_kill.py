@@ -1,4 +1,4 @@
-"""Kill test (issue 22): noise-gen's four outputs (KTX2, EXR, PNG, depfile) are one transaction.
+"""Kill test: noise-gen's four outputs (KTX2, EXR, PNG, depfile) are one transaction.
 SIGKILL at random moments of a run that replaces set A by set B leaves set A, set B, or (killed
 between the renames of the commit) a mixed set with its journal, which the next run completes
 to set B; after the next run no temporary file or journal is left.

@@ -1,4 +1,4 @@
-"""Hostile inputs (issue 22): every number of a file or an option is checked for finiteness and
+"""Hostile inputs: every number of a file or an option is checked for finiteness and
 its physical range before any work, names cannot escape the outputs folder, and a failed
 command leaves the previous outputs byte-identical (runs the real binaries)."""
 import os

@@ -1,7 +1,6 @@
 // ocio/config.ocio and the OCIO-based conversions: ociocheck, the published checked values of
 // the transforms, round trips, the XYZ convention of each observer, previews and determinism.
 #include <gtest/gtest.h>
-#include <tbb/global_control.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -14,6 +13,7 @@
 #include "io/png.h"
 #include "spectrum/cmf.h"
 #include "spectrum/xyz.h"
+#include "support/threads.h"
 
 using namespace skybake;
 namespace fs = std::filesystem;
@@ -81,7 +81,7 @@ TEST(OcioConfig, Cie2006MappingMatchesTheDataTables) {
   EXPECT_NEAR(build.d65_cie2006.Z, 1.07540434, 1e-8);
 }
 
-// Checked values (../shared/notes/ninja-ocio-exr-ktx.md §2.2, computed with OCIO 2.1.2 on Debian
+// Checked values (computed with OCIO 2.1.2 on Debian
 // 12): Rec.2020 (1,1,1) -> XYZ (0.950456, 1, 1.08906), i.e. the D65 white xy (0.3127, 0.3290);
 // Rec.2020 red -> (0.636958, 0.2627, 0) (ITU-R BT.2100 Table 4 Y coefficient 0.2627).
 TEST(OcioConfig, Rec2020ToXyzCheckedValues) {
@@ -199,16 +199,11 @@ TEST(Preview, PngThroughDisplayView) {
   }
   ColorProcessor view = Config().Display(ocio_names::kLinearRec709, DisplayView{.white_cd_m2 = 1000.0});
   const fs::path out = fs::path(::testing::TempDir()) / "skybake_preview_test.png";
-  std::string bytes1, bytes2;
-  {
-    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+  const std::string bytes1 = test::WithThreads(1, [&] {
     WritePreviewPng(out, w, h, rgb, view);
-    bytes1 = ReadFileBytes(out);
-  }
-  {
-    tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);
-    bytes2 = EncodePng8(w, h, 3, EncodePreview8(w, h, rgb, view));
-  }
+    return ReadFileBytes(out);
+  });
+  const std::string bytes2 = test::WithThreads(2, [&] { return EncodePng8(w, h, 3, EncodePreview8(w, h, rgb, view)); });
   EXPECT_EQ(bytes1, bytes2);
   EXPECT_FALSE(WritePreviewPng(out, w, h, rgb, view));  // unchanged content: not rewritten
   int dw = 0, dh = 0, dc = 0;
@@ -235,11 +230,8 @@ TEST(Preview, ParallelApplyIsDeterministic) {
   std::uniform_real_distribution<float> u(0.0f, 5000.0f);
   for (float& v : a) v = u(rng);
   std::vector<float> serial = a, parallel = a;
-  {
-    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-    p.Apply(serial);
-  }
-  p.Apply(parallel);
+  test::WithThreads(1, [&] { p.Apply(serial); });
+  test::WithThreads(4, [&] { p.Apply(parallel); });
   EXPECT_EQ(serial, parallel);
 }
 

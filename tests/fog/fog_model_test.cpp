@@ -1,4 +1,4 @@
-// GT7's depth model (fog/fog_model.h; ../shared/seeds/gt7-sky-talk.txt, "Global Fog
+// GT7's depth model (fog/fog_model.h; GT7 sky talk, "Global Fog
 // Approximation"): Fog = LUT(dir) (1 - exp(-a theta^p x)) / (1 - exp(-a theta^p)). Laws checked:
 // the closed-form limits (x -> 1 gives the LUT value, x -> 0 gives 0, a -> 0 gives x), the
 // derivative used by the fit against finite differences, the model being exact for a homogeneous
@@ -12,13 +12,14 @@
 
 #include "fog/fog_model.h"
 #include "io/error.h"
+#include "support/log.h"
 
 using namespace skybake;
 using namespace skybake::fog;
 
 namespace {
 constexpr double kPi = std::numbers::pi;
-// Earth (6371 km, ../shared/seeds/gt7-sky-talk.txt geometry as in docs/lut-pack.md), observer on
+// Earth (6371 km, the GT7 sky talk's geometry as in docs/lut-pack.md), observer on
 // the ground, cut at 3.5 km (docs/fog.md, "The cut").
 FogGeometry Earth() { return FogGeometry(6371e3, 0.0, 3500.0); }
 }  // namespace
@@ -95,7 +96,7 @@ TEST(FogModel, DerivativeMatchesFiniteDifferences) {
       worst = std::max(worst, std::fabs(an - fd) / std::max(std::fabs(fd), 1e-6));
     }
   }
-  std::printf("dF/dk vs finite differences: worst relative difference %.2g\n", worst);
+  SKYBAKE_LOG("dF/dk vs finite differences: worst relative difference %.2g\n", worst);
   EXPECT_EQ(DepthFactorDk(0.0, 1.0), 0.0);
   EXPECT_EQ(DepthFactorDk(1.0, 1.0), 0.0);
 }

@@ -1,5 +1,5 @@
 // The reference fog renders, the packed LUTs and the reference evaluator on a physical sky
-// (fog/fog_render.h, fog/fog_luts.h, fog/fog_evaluator.h; ../shared/seeds/gt7-sky-talk.txt,
+// (fog/fog_render.h, fog/fog_luts.h, fog/fog_evaluator.h; GT7 sky talk,
 // "Fog"). Laws:
 //  - consistency: at infinite depth (the low-atmosphere boundary) the fog LUT, decoded by the
 //    evaluator, equals a direct render (SkyMethod::SegmentRadiance) of the same restricted
@@ -16,8 +16,6 @@
 // a 32 x 32 LUT (the product's size) on 5 slices (gt7-quadratic:3+2): small, so that the suite stays fast
 // (about 32 s on one core, Release; 28 s of it the path-traced comparison).
 #include <gtest/gtest.h>
-
-#include <tbb/global_control.h>
 
 #include <cmath>
 #include <cstdio>
@@ -37,6 +35,8 @@
 #include "optics/polydisperse.h"
 #include "spectrum/cmf.h"
 #include "spectrum/xyz.h"
+#include "support/log.h"
+#include "support/threads.h"
 #include "transport/sky_scene.h"
 #include "transport/view_segment.h"
 
@@ -170,7 +170,7 @@ TEST(FogRender, InfiniteDepthEqualsDirectRenderAtNodes) {
       worst = std::max(worst, e);
     }
   }
-  std::printf("fog LUT at its nodes vs direct render: worst luminance error %.3f %%\n", 100 * worst);
+  SKYBAKE_LOG("fog LUT at its nodes vs direct render: worst luminance error %.3f %%\n", 100 * worst);
   EXPECT_LT(worst, 0.01);
 }
 
@@ -205,10 +205,10 @@ TEST(FogRender, InfiniteDepthEqualsDirectRenderBetweenNodes) {
         where = i;
       }
     }
-    std::printf("  worst at direction (%.3f, %.3f, %.3f): %.4g vs direct %.4g\n", dirs[where][0], dirs[where][1], dirs[where][2],
+    SKYBAKE_LOG("  worst at direction (%.3f, %.3f, %.3f): %.4g vs direct %.4g\n", dirs[where][0], dirs[where][1], dirs[where][2],
                 Luma(f.eval->Evaluate(dirs[where], 1e12, sza * kDeg).inscattered), Luma(direct[where]));
     const double rms = std::sqrt(sum2 / static_cast<double>(dirs.size()));
-    std::printf("fog LUT between nodes, sun %.2f deg: RMS %.2f %%, max %.2f %%\n", sza, 100 * rms, 100 * worst);
+    SKYBAKE_LOG("fog LUT between nodes, sun %.2f deg: RMS %.2f %%, max %.2f %%\n", sza, 100 * rms, 100 * worst);
     EXPECT_LT(rms, latlong ? 0.045 : 0.02) << sza;
     EXPECT_LT(worst, latlong ? 0.10 : 0.05) << sza;
   }
@@ -222,7 +222,7 @@ TEST(FogRender, InfiniteDepthEqualsDirectRenderBetweenNodes) {
 TEST(FogRender, DepthTablesMatchTheLutAtInfiniteDepth) {
   const Fixture& f = Clear();
   const ErrorStats& s = f.products.fog_eval.infinite_depth;
-  std::printf("depth tables (x = 1) vs decoded LUT: RMS %.2f %%, max %.2f %% (%zu samples)\n", 100 * s.rms, 100 * s.max, s.count);
+  SKYBAKE_LOG("depth tables (x = 1) vs decoded LUT: RMS %.2f %%, max %.2f %% (%zu samples)\n", 100 * s.rms, 100 * s.max, s.count);
   EXPECT_GT(s.count, 0u);
   EXPECT_LT(s.rms, 0.03);
   EXPECT_LT(s.max, 0.15);
@@ -313,7 +313,7 @@ TEST(FogRender, AttenuationMatchesExactTransmittance) {
     }
   }
   const double rms = std::sqrt(sum2 / static_cast<double>(n));
-  std::printf("attenuation LUT vs exact: nodes worst %.4f; half-way worst %.4f, RMS %.4f (absolute)\n", worst_node, worst_mid, rms);
+  SKYBAKE_LOG("attenuation LUT vs exact: nodes worst %.4f; half-way worst %.4f, RMS %.4f (absolute)\n", worst_node, worst_mid, rms);
   EXPECT_LT(worst_node, 0.01);
   EXPECT_LT(worst_mid, 0.06);
   EXPECT_LT(rms, 0.012);
@@ -327,16 +327,16 @@ TEST(FogRender, AttenuationMatchesExactTransmittance) {
 // how the share of the fog near the camera changes with the elevation, which theta^p cannot
 // follow). Bounds: RMS 8 % (all), 6.5 % (near the camera), 20 % (horizon), max 70 %. The evaluator
 // on the packed LUTs adds the LUT's interpolation: measured RMS 7.40 % (all), 5.84 % (near the
-// camera), bounds 9 % and 7 % (14.1 % and 14.9 % with the global pair on texel centres before).
+// camera), bounds 9 % and 7 %.
 TEST(FogRender, ModelErrorAgainstReference) {
   const Fixture& f = Clear();
   const FogProducts& p = f.products;
-  std::printf("fit: all RMS %.2f %% max %.1f %%; near RMS %.2f %% max %.1f %%; horizon RMS %.2f %% max %.1f %%\n",
+  SKYBAKE_LOG("fit: all RMS %.2f %% max %.1f %%; near RMS %.2f %% max %.1f %%; horizon RMS %.2f %% max %.1f %%\n",
               100 * p.fog_fit.all.rms, 100 * p.fog_fit.all.max, 100 * p.fog_fit.near.rms, 100 * p.fog_fit.near.max,
               100 * p.fog_fit.horizon.rms, 100 * p.fog_fit.horizon.max);
-  std::printf("evaluator: all RMS %.2f %%; near RMS %.2f %%; horizon RMS %.2f %%\n", 100 * p.fog_eval.all.rms,
+  SKYBAKE_LOG("evaluator: all RMS %.2f %%; near RMS %.2f %%; horizon RMS %.2f %%\n", 100 * p.fog_eval.all.rms,
               100 * p.fog_eval.near.rms, 100 * p.fog_eval.horizon.rms);
-  std::printf("fit a = %.4g %.4g %.4g, p = %.4g %.4g %.4g\n", p.params.a[0], p.params.a[1], p.params.a[2], p.params.p[0],
+  SKYBAKE_LOG("fit a = %.4g %.4g %.4g, p = %.4g %.4g %.4g\n", p.params.a[0], p.params.a[1], p.params.a[2], p.params.p[0],
               p.params.p[1], p.params.p[2]);
   EXPECT_LT(p.fog_fit.all.rms, 0.08);
   EXPECT_LT(p.fog_fit.near.rms, 0.065);
@@ -386,7 +386,7 @@ TEST(FogRender, PerSliceParametersFollowTheSlices) {
   // Measured: near the camera 8.08 % vs the global pair's 8.90 %, all 8.77 % vs 9.94 %.
   const FitDiagnostic& global = ps.diagnostics[0];
   ASSERT_EQ(global.name, "global");
-  std::printf("per-slice fit near camera RMS %.2f %% vs global %.2f %%; all %.2f %% vs %.2f %%\n", 100 * ps.fog_fit.near.rms,
+  SKYBAKE_LOG("per-slice fit near camera RMS %.2f %% vs global %.2f %%; all %.2f %% vs %.2f %%\n", 100 * ps.fog_fit.near.rms,
               100 * global.near.rms, 100 * ps.fog_fit.all.rms, 100 * global.all.rms);
   EXPECT_LE(ps.fog_fit.all.rms, global.all.rms * (1 + 1e-9));
   // The global mode: no per-slice rows, the same (a, p) at every sun angle.
@@ -438,15 +438,8 @@ TEST(FogRender, DeterministicAcrossThreads) {
   FogRenderOptions o = SmallOptions();
   o.lut_width = o.lut_height = 4;
   o.sun_zenith_deg = {60};
-  FogRender a, b;
-  {
-    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
-    a = RenderFog(f.scene, o, {});
-  }
-  {
-    tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);
-    b = RenderFog(f.scene, o, {});
-  }
+  const FogRender a = test::WithThreads(1, [&] { return RenderFog(f.scene, o, {}); });
+  const FogRender b = test::WithThreads(2, [&] { return RenderFog(f.scene, o, {}); });
   EXPECT_EQ(a.slice_xyz, b.slice_xyz);
   EXPECT_EQ(a.slice_shadowed_xyz, b.slice_shadowed_xyz);
   EXPECT_EQ(a.tables[0].xyz, b.tables[0].xyz);
@@ -476,7 +469,7 @@ TEST(FogRender, PathAgreesWithOrders) {
   const FogDepthTable& tp = path.tables[0];
   for (size_t i = 0; i < tp.y_stderr.size(); ++i) {
     const double yo = to.xyz[i * 3 + 1], yp = tp.xyz[i * 3 + 1];
-    std::printf("path %.5g +- %.2g, orders %.5g (%+.1f %%)\n", yp, tp.y_stderr[i], yo, 100 * (yo / yp - 1));
+    SKYBAKE_LOG("path %.5g +- %.2g, orders %.5g (%+.1f %%)\n", yp, tp.y_stderr[i], yo, 100 * (yo / yp - 1));
     EXPECT_NEAR(yo, yp, 0.06 * yp + 2 * tp.y_stderr[i]) << i;
     EXPECT_GT(tp.y_stderr[i], 0.0f);
   }

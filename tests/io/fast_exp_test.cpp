@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "io/fast_exp.h"
+#include "support/log.h"
 
 using namespace skybake;
 
@@ -17,7 +18,7 @@ TEST(FastExp, WithinTwoUlpOfTheDoubleExp) {
     const double ref = std::exp(static_cast<double>(x));
     worst = std::max(worst, std::abs(static_cast<double>(ExpF(x)) / ref - 1.0));
   }
-  std::printf("ExpF: max relative error %.3g on [-87, 88] (float epsilon 1.19e-7)\n", worst);
+  SKYBAKE_LOG("ExpF: max relative error %.3g on [-87, 88] (float epsilon 1.19e-7)\n", worst);
   EXPECT_LT(worst, 2.0 * std::numeric_limits<float>::epsilon());
 }
 
@@ -58,7 +59,7 @@ TEST(FastLog, WithinItsStatedErrorOfTheDoubleLog) {
       else worst_rel = std::max(worst_rel, err / std::abs(ref));
     }
   }
-  std::printf("LogF: max absolute error %.3g on [1/2, 2], max relative error %.3g elsewhere\n", worst_abs, worst_rel);
+  SKYBAKE_LOG("LogF: max absolute error %.3g on [1/2, 2], max relative error %.3g elsewhere\n", worst_abs, worst_rel);
   EXPECT_LT(worst_abs, 1.5e-7);
   EXPECT_LT(worst_rel, 1.5e-7);
   EXPECT_EQ(LogF(1.0f), 0.0f);
@@ -74,6 +75,6 @@ TEST(FastLog, ExpOfLogRoundTrips) {
     const float r = std::exp2(-20.0f + 40.0f * static_cast<float>(i) / 100000.0f);
     worst = std::max(worst, std::abs(static_cast<double>(ExpF(LogF(r))) / r - 1.0));
   }
-  std::printf("ExpF(LogF(r)) / r - 1: max %.3g on [2^-20, 2^20]\n", worst);
+  SKYBAKE_LOG("ExpF(LogF(r)) / r - 1: max %.3g on [2^-20, 2^20]\n", worst);
   EXPECT_LT(worst, 8.0 * std::numeric_limits<float>::epsilon());
 }

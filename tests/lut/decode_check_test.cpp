@@ -1,4 +1,4 @@
-// The decode check on a physical sky (issue 6, "What must be shown"): the clear basis sky
+// The decode check on a physical sky: the clear basis sky
 // rendered by a deterministic method on the GT7 mapping at two neighbouring slices, converted
 // and packed exactly as lut-pack does (OCIO XYZ -> Linear Rec.2020, R11G11B10F), decoded by the
 // reference decoder at the sun angle half-way between the slices (in the time mapping's slice
@@ -34,6 +34,7 @@
 #include "optics/polydisperse.h"
 #include "spectrum/cmf.h"
 #include "spectrum/xyz.h"
+#include "support/log.h"
 #include "transport/sky_method.h"
 #include "transport/sky_render.h"
 
@@ -174,7 +175,7 @@ Figures CheckPair(const std::string& time_mapping, int i, const std::string& met
   }
   f.rms = std::sqrt(e2_all / w_all);
   f.rms_outside_5deg = std::sqrt(e2_out / w_out);
-  std::printf("%s %s %s slices %2d-%2d, sun zenith %7.3f deg (%s/%s): RMS %.3f %% (%.3f %% outside 5 deg of the sun), max %+.2f %% at "
+  SKYBAKE_LOG("%s %s %s slices %2d-%2d, sun zenith %7.3f deg (%s/%s): RMS %.3f %% (%.3f %% outside 5 deg of the sun), max %+.2f %% at "
               "zenith %.1f, azimuth %.1f, %.1f deg from the sun\n",
               method.c_str(), lut::TimeInterpolationName(interp), time_mapping.c_str(), i, i + 1, tm / kDeg, gt7::SphereFamilyName(gt7::SphereMapping{}.FamilyFor(t0)),
               gt7::SphereFamilyName(gt7::SphereMapping{}.FamilyFor(t1)), 100 * f.rms, 100 * f.rms_outside_5deg, 100 * f.max,
@@ -197,8 +198,8 @@ TEST(DecodeCheck, QuadraticTimeMappingWithinTwoPercentRms) {
 TEST(DecodeCheck, DeepTwilightWithMultipleScattering) {
   // Below -1 deg the single-scattering sky is black in the Earth's shadow and its terminator
   // sweeps across the sky: a method with multiple scattering is needed for a meaningful check.
-  // The geometric time interpolation stays within 2.5 % (measured 0.8-2.3 % with `orders` of
-  // 2026-11-23; 2.3 % at slices 60-61, sun 96.9 deg, where `orders` itself interpolates its
+  // The geometric time interpolation stays within 2.5 % (measured 0.8-2.3 % with `orders`;
+  // 2.3 % at slices 60-61, sun 96.9 deg, where `orders` itself interpolates its
   // tables linearly between sun nodes 1 deg apart while the twilight sky falls ~e-fold per
   // degree: docs/sky-methods.md "Twilight"); the linear one is 15-21 % off half-way in deep
   // twilight and is printed for the record.

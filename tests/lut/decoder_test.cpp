@@ -11,6 +11,7 @@
 
 #include "lut/decoder.h"
 #include "lut/gt7_mapping.h"
+#include "support/log.h"
 
 using namespace skybake;
 using namespace skybake::lut;
@@ -127,7 +128,7 @@ TEST(Decoder, NodeGridHasARowAtTheZenith) {
         worst_n = std::max(worst_n, std::fabs(n.Radiance(dir, sza * kDeg)[1] / want - 1.0));
       }
     }
-    std::printf("sun zenith %.0f deg, views within 20 deg of the zenith: max error centres %.1f %%, nodes %.1f %%\n", sza,
+    SKYBAKE_LOG("sun zenith %.0f deg, views within 20 deg of the zenith: max error centres %.1f %%, nodes %.1f %%\n", sza,
                 100 * worst_c, 100 * worst_n);
     EXPECT_LT(worst_n, 0.025) << sza;
     EXPECT_LT(worst_n, 0.25 * worst_c) << sza;
@@ -145,7 +146,7 @@ TEST(Decoder, InterpolationErrorIsSecondOrderInResolution) {
   for (int k : {5, 20, 30, 40, 50}) {
     const double ts = time.SliceZenithRad(k);
     const double ea = Error(a, ts).first, eb = Error(b, ts).first;
-    std::printf("slice %d (sun zenith %.2f deg, %s): RMS %.3g %% at 16x64, %.3g %% at 32x128, ratio %.2f\n", k, ts / kDeg,
+    SKYBAKE_LOG("slice %d (sun zenith %.2f deg, %s): RMS %.3g %% at 16x64, %.3g %% at 32x128, ratio %.2f\n", k, ts / kDeg,
                 gt7::SphereFamilyName(sphere.FamilyFor(ts)), 100 * ea, 100 * eb, ea / eb);
     EXPECT_GT(ea / eb, sphere.FamilyFor(ts) == gt7::SphereFamily::kSunAligned ? 3.0 : 1.8) << k;
     EXPECT_LT(eb, 0.01) << k;

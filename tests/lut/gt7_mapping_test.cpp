@@ -13,6 +13,7 @@
 #include "io/error.h"
 #include "lut/directions.h"
 #include "lut/gt7_mapping.h"
+#include "support/log.h"
 
 using namespace skybake;
 using namespace skybake::gt7;
@@ -73,9 +74,9 @@ TEST(Gt7Time, SlicesFollowTheTalksTwoRegions) {
   }
   // More slices near the horizon: the steps shrink towards 90 deg in the upper region.
   for (int i = 2; i < 48; ++i) EXPECT_LT(z[i] - z[i - 1], z[i - 1] - z[i - 2] + 1e-12) << i;
-  std::printf("gt7 slices (deg):");
-  for (int i = 0; i < 64; ++i) std::printf("%s%.4f", i % 8 ? " " : "\n  ", z[i]);
-  std::printf("\n");
+  SKYBAKE_LOG("gt7 slices (deg):");
+  for (int i = 0; i < 64; ++i) SKYBAKE_LOG("%s%.4f", i % 8 ? " " : "\n  ", z[i]);
+  SKYBAKE_LOG("\n");
 }
 
 TEST(Gt7Time, SliceCoordinateIsTheInverse) {
@@ -145,9 +146,9 @@ TEST(Gt7Time, QuadraticVariantSpendsSlicesOnHighSun) {
   EXPECT_NEAR(z[1], 5.6, 0.1);
   EXPECT_NEAR(zt[1], 35.25, 0.01);
   EXPECT_LT(z[47] - z[46], 0.5);  // still dense at the horizon (0.2 deg for the talk's)
-  std::printf("gt7-quadratic slices (deg):");
-  for (int i = 0; i < 64; ++i) std::printf("%s%.4f", i % 8 ? " " : "\n  ", z[i]);
-  std::printf("\n");
+  SKYBAKE_LOG("gt7-quadratic slices (deg):");
+  for (int i = 0; i < 64; ++i) SKYBAKE_LOG("%s%.4f", i % 8 ? " " : "\n  ", z[i]);
+  SKYBAKE_LOG("\n");
 }
 
 // ------------------------------------------------------------------------------------- sphere
@@ -275,7 +276,7 @@ TEST(Gt7Sphere, UvToDirectionToUvWithin1e5TexelEverywhere) {
       }
     }
   }
-  std::printf("worst uv -> direction -> uv error: %.3g texel (%s)\n", worst, where.c_str());
+  SKYBAKE_LOG("worst uv -> direction -> uv error: %.3g texel (%s)\n", worst, where.c_str());
   EXPECT_LT(worst, 1e-5) << where;
 }
 

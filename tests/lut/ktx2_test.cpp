@@ -4,8 +4,8 @@
 //
 // Expected values come from the KTX 2.0 specification (KhronosGroup/KTX-Specification
 // ktxspec.adoc) and the Khronos Data Format Specification 1.3 basic descriptor block as written
-// by KTX-Software lib/dfdutils (createdfd.c); the B10G11R11 DFD from notes/ninja-ocio-exr-ktx.md
-// §4.2. They are written out by hand below, not computed by the code under test.
+// by KTX-Software lib/dfdutils (createdfd.c); the B10G11R11 DFD from lib/dfdutils
+// vk2dfd.inl. They are written out by hand below, not computed by the code under test.
 #include <gtest/gtest.h>
 
 #include <Imath/half.h>
@@ -461,7 +461,7 @@ TEST(Texels, EncodeDecodeRoundTripsPerFormat) {
   EXPECT_THROW(EncodeTexels(B10G11R11UfloatPack32(), {0.0f, 0.0f, 0.0f}), InternalError);
 }
 
-// Found by tests/fuzz/fuzz_ktx2 (issue 22): a header whose level 0 starts past the end of a
+// Found by tests/fuzz/fuzz_ktx2.cpp: a header whose level 0 starts past the end of a
 // truncated file was read beyond the buffer (ASan: heap-buffer-overflow) while checking
 // mipPadding; it is bad input.
 TEST(Ktx2, FileEndingBeforeItsLevelIsBadInput) {

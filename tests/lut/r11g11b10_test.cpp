@@ -4,8 +4,8 @@
 // layout (R in bits 0-10, G in 11-21, B in 22-31).
 //
 // The definitions are the Vulkan / Khronos Data Format Specification 1.3 §10.3 ones, written out
-// here as ldexp expressions (not taken from the code under test). The GLM failure cases of
-// notes/ninja-ocio-exr-ktx.md §4.4 (1e-6 -> 4288, 3e-5 -> 128000, 1e5 -> 99328, -0.5 -> 0.5) are
+// here as ldexp expressions (not taken from the code under test). The failure cases of GLM
+// 0.9.9.8's packF2x11_1x10 (g-truc/glm #602: 1e-6 -> 4288, 3e-5 -> 128000, 1e5 -> 99328, -0.5 -> 0.5) are
 // checked explicitly.
 #include <gtest/gtest.h>
 

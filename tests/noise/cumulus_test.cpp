@@ -2,14 +2,13 @@
 // world-space shift, coverage and type statistics, determinism, YAML errors.
 #include <gtest/gtest.h>
 
-#include <tbb/task_arena.h>
-
 #include <cmath>
 #include <cstring>
 #include <filesystem>
 
 #include "io/error.h"
 #include "noise/cumulus.h"
+#include "support/threads.h"
 
 using namespace skybake;
 using namespace skybake::noise;
@@ -148,10 +147,8 @@ TEST(CumulusMap, AdvectionIsAWorldSpaceShiftByWindTimesTime) {
 TEST(CumulusMap, SameBytesAtAnyThreadCount) {
   const CumulusSpec s = TestSpec();
   const WeatherField field(s.weather);
-  CumulusMap a, b;
-  tbb::task_arena one(1), two(2);
-  one.execute([&] { a = GenerateCumulusMap(s, WeatherField(s.weather)); });
-  two.execute([&] { b = GenerateCumulusMap(s, field); });
+  const CumulusMap a = test::WithThreads(1, [&] { return GenerateCumulusMap(s, WeatherField(s.weather)); });
+  const CumulusMap b = test::WithThreads(2, [&] { return GenerateCumulusMap(s, field); });
   ASSERT_EQ(a.values.size(), b.values.size());
   EXPECT_EQ(std::memcmp(a.values.data(), b.values.data(), a.values.size() * sizeof(float)), 0);
   CumulusSpec other = s;

@@ -3,8 +3,6 @@
 // and seed sensitivity, YAML errors word for word, and the repository's three volumes at full size.
 #include <gtest/gtest.h>
 
-#include <tbb/task_arena.h>
-
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -13,6 +11,7 @@
 #include "lut/ktx2.h"
 #include "noise/spectrum.h"
 #include "noise/volume.h"
+#include "support/threads.h"
 
 using namespace skybake;
 using namespace skybake::noise;
@@ -53,10 +52,7 @@ VolumeSpec Spec(std::vector<ChannelSpec> ch, int n, Normalization norm, uint64_t
   return s;
 }
 GeneratedVolume GenerateWithThreads(const VolumeSpec& s, int threads) {
-  tbb::task_arena arena(threads);
-  GeneratedVolume g;
-  arena.execute([&] { g = GenerateVolume(s); });
-  return g;
+  return test::WithThreads(threads, [&] { return GenerateVolume(s); });
 }
 
 // First and second differences along `axis`, split into the pairs/triples that straddle the

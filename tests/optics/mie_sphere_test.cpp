@@ -138,7 +138,7 @@ TEST(MieSphere, MatchesWiscombeMiev0TestCases) {
     EXPECT_TRUE(Rel("Q_ext", r.q.qext, c.qext, 1e-6));
     EXPECT_TRUE(Rel("Q_sca", r.q.qsca, c.qsca, 1e-6));
     // Case 5 (x max(1,|m|) = 0.099 <= 0.1) was computed by MIEV0's small-particle series, good to
-    // ~2e-6 (notes/mie-numerics.md §1.3); an 80-bit evaluation of the full series gives
+    // ~2e-6 (Wiscombe 1980, SMALL2); an 80-bit evaluation of the full series gives
     // g Q_sca = 1.0742772e-08, ours to 1e-12. The 7-digit print is the approximation's.
     EXPECT_TRUE(Rel("g Q_sca", r.q.gqsca, c.gqsc, c.id == 5 ? 2e-6 : 1e-6));
     const double qback = 4.0 * (c.s[6][0] * c.s[6][0] + c.s[6][1] * c.s[6][1]) / (c.x * c.x);

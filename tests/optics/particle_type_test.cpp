@@ -77,7 +77,7 @@ std::string LoadErrors(const TempDir& dir, const std::string& yaml) {
 
 }  // namespace
 
-// Hatch-Choate relations of the log-normal (Hansen & Travis 1974; notes/mie-numerics.md §3.1)
+// Hatch-Choate relations of the log-normal (Hansen & Travis 1974, eqs. 2.53-2.56)
 // against a direct numerical integration of the truncated distribution.
 TEST(ParticleType, LogNormalAlgebraMatchesNumericalMoments) {
   TempDir dir;

@@ -2,7 +2,6 @@
 // sigma limit, the refinement criterion against a finer reference, mixtures, Rayleigh limits,
 // normalisation and thread independence of whole tables.
 #include <gtest/gtest.h>
-#include <tbb/global_control.h>
 
 #include <cmath>
 #include <filesystem>
@@ -11,6 +10,7 @@
 #include "io/yaml.h"
 #include "optics/mie_angular.h"
 #include "optics/polydisperse.h"
+#include "support/threads.h"
 
 namespace fs = std::filesystem;
 using namespace skybake;
@@ -202,15 +202,8 @@ TEST(Polydisperse, AngleGridResolvesTheCoarseModePeak) {
 TEST(Polydisperse, TablesDoNotDependOnTheThreadCount) {
   const ParticleType t = LoadParticleType(fs::path(SKYBAKE_SOURCE_DIR) / "particles" / "continental.yaml");
   const std::vector<double> wl{450.0, 650.0};
-  MieBuild one, two;
-  {
-    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 1);
-    one = BuildMieTable(t, wl, MieBuildOptions{});
-  }
-  {
-    tbb::global_control c(tbb::global_control::max_allowed_parallelism, 2);
-    two = BuildMieTable(t, wl, MieBuildOptions{});
-  }
+  const MieBuild one = test::WithThreads(1, [&] { return BuildMieTable(t, wl, MieBuildOptions{}); });
+  const MieBuild two = test::WithThreads(2, [&] { return BuildMieTable(t, wl, MieBuildOptions{}); });
   EXPECT_EQ(one.table.cext_m2, two.table.cext_m2);
   EXPECT_EQ(one.table.g, two.table.g);
   EXPECT_EQ(one.table.phase, two.table.phase);

@@ -17,8 +17,9 @@ CsvTable Data(const std::string& name) { return CsvTable::Load(std::string(SKYBA
 }  // namespace
 
 // Our implementation of Bodhaine et al. 1999 eqs. 2-23 reproduces the values computed
-// independently from the same published formulas (atmospheres/data/rayleigh_checkpoints_
-// bodhaine1999_computed.csv, 400-700 nm, 360 ppm CO2) to 1e-5: n-1, King factor, sigma.
+// independently from the same published formulas
+// (atmospheres/data/rayleigh_checkpoints_bodhaine1999_computed.csv, 400-700 nm, 360 ppm CO2) to
+// 1e-5: n-1, King factor, sigma.
 TEST(Rayleigh, ReproducesBodhaineFormulas) {
   CsvTable t = Data("rayleigh_checkpoints_bodhaine1999_computed.csv");
   Diagnostics d;

@@ -1,4 +1,4 @@
-"""The `clouds` section of pipeline.yaml (issue 8) on a temporary copy: noise-gen and cumulus-map
+"""The `clouds` section of pipeline.yaml on a temporary copy: noise-gen and cumulus-map
 edges, and their independence - an edit to the cumulus settings re-runs no noise volume and an
 edit to one volume re-runs only that volume; a sequence of map times; errors located in the file
 that has them."""

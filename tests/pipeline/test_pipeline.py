@@ -1,4 +1,4 @@
-"""The generated Ninja pipeline on a temporary copy of the repo's atmospheres (issue 2).
+"""The generated Ninja pipeline on a temporary copy of the repo's atmospheres.
 
 Checks: a fresh bake builds; a second run has no work; an edit to one atmosphere re-runs only
 that atmosphere's edges; comment/whitespace edits re-run nothing downstream; missingdeps is

@@ -29,7 +29,7 @@ double BlackbodyFractionBelow(double wavelength_nm, double temperature_k) {
 }  // namespace
 
 // ASTM G173-03 gives 1366.1 W/m² for the whole extraterrestrial spectrum; the table stops at 4 µm
-// and holds 1347.93 W/m² (trapezoid, as in ../shared/data/SOURCES.md). A blackbody at the Sun's
+// and holds 1347.93 W/m² (trapezoid, as in atmospheres/data/SOURCES.md). A blackbody at the Sun's
 // effective temperature (5772 K, IAU 2015 Resolution B3) puts 0.976 % of its energy beyond 4 µm,
 // so the table should hold 1366.1 × 0.99024 = 1352.8 W/m²: agreement within 0.5 % (the real
 // Sun's infrared departs from a blackbody).

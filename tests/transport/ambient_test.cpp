@@ -8,6 +8,7 @@
 #include <functional>
 
 #include "method_scenes.h"
+#include "support/log.h"
 #include "transport/ambient.h"
 
 using namespace skybake;
@@ -114,7 +115,7 @@ TEST(Ambient, NarrowAureoleAroundTheSun) {
     grid.sun_cap = false;
     const double with_cap = AmbientIrradiance(sky, 0.0, sun * kDeg)[0] / exact - 1.0;
     const double grid_only = AmbientIrradiance(sky, 0.0, sun * kDeg, grid)[0] / exact - 1.0;
-    std::printf("sun %.0f: aureole E %.4g, with the cap %+.4f %%, the grid alone %+.1f %%\n", sun, exact, 100.0 * with_cap,
+    SKYBAKE_LOG("sun %.0f: aureole E %.4g, with the cap %+.4f %%, the grid alone %+.1f %%\n", sun, exact, 100.0 * with_cap,
                 100.0 * grid_only);
     EXPECT_LT(std::abs(with_cap), 1e-3) << "sun " << sun;
     EXPECT_GT(std::abs(grid_only), 0.05) << "sun " << sun;
@@ -137,7 +138,7 @@ TEST(Ambient, ThinCloudAureole) {
     const double ref = DenseY(*m, sc, ts, 60, 160);
     const double with_cap = Y(sc, AmbientIrradiance(*m, 1.0, ts)) / ref - 1.0;
     const double grid_only = Y(sc, AmbientIrradiance(*m, 1.0, ts, grid)) / ref - 1.0;
-    std::printf("cloudy1, sun %.0f: dense %.1f lx, with the cap %+.3f %%, the grid alone %+.2f %%\n", sun, ref,
+    SKYBAKE_LOG("cloudy1, sun %.0f: dense %.1f lx, with the cap %+.3f %%, the grid alone %+.2f %%\n", sun, ref,
                 100.0 * with_cap, 100.0 * grid_only);
     EXPECT_LT(std::abs(with_cap), 2e-3) << "sun " << sun;
     EXPECT_GT(std::abs(grid_only), 0.03) << "sun " << sun;

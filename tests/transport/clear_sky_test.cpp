@@ -1,5 +1,5 @@
 // The clear basis sky rendered by the path tracer has the structure and the magnitudes of a real
-// clear sky (issue 4): blue zenith, bright horizon band, aureole, red sunset horizon, the Earth's
+// clear sky: blue zenith, bright horizon band, aureole, red sunset horizon, the Earth's
 // shadow in twilight; luminances and illuminances inside published daylight ranges.
 // Reference ranges (cited per check) are wide on purpose: they check physics, not a snapshot;
 // the measured values are printed and listed in docs/sky-render.md.
@@ -17,6 +17,7 @@
 #include "optics/polydisperse.h"
 #include "spectrum/cmf.h"
 #include "spectrum/xyz.h"
+#include "support/log.h"
 #include "transport/path_tracer.h"
 
 using namespace skybake;
@@ -78,7 +79,7 @@ TEST(ClearSky, HighSun) {
   ColorEstimate aureole = sky.At(33, 0, 3);  // 3 deg from the sun centre
   ColorEstimate side = sky.At(30, 90, 4);    // same elevation, ~60 deg from the sun
   ColorEstimate ambient = sky.tracer.Irradiance(sky.obs, sky.sun, 5);
-  std::printf("sun 60: zenith Y %.0f cd/m2 (x %.3f), horizon Y %.0f, aureole %.0f, side %.0f, ambient %.0f lx\n",
+  SKYBAKE_LOG("sun 60: zenith Y %.0f cd/m2 (x %.3f), horizon Y %.0f, aureole %.0f, side %.0f, ambient %.0f lx\n",
               zenith.xyz[1], X(zenith), horizon.xyz[1], aureole.xyz[1], side.xyz[1], ambient.xyz[1]);
   // Blue zenith: CIE 1931 x well below the white point's 0.3127 (clear skies measure x ~ 0.25-0.29,
   // e.g. Kider et al. 2014 / CIE S 011 sky types 11-13 colour data).
@@ -102,7 +103,7 @@ TEST(ClearSky, SunsetHorizonIsRed) {
   ColorEstimate zenith = sky.At(0, 0, 11);
   ColorEstimate sunward = sky.At(88, 10, 12);
   ColorEstimate antisun = sky.At(88, 180, 13);
-  std::printf("sun 0: zenith Y %.1f (x %.3f), sunward horizon Y %.1f (x %.3f), antisun horizon Y %.1f (x %.3f)\n",
+  SKYBAKE_LOG("sun 0: zenith Y %.1f (x %.3f), sunward horizon Y %.1f (x %.3f), antisun horizon Y %.1f (x %.3f)\n",
               zenith.xyz[1], X(zenith), sunward.xyz[1], X(sunward), antisun.xyz[1], X(antisun));
   // At sunset the sky towards the sun is orange-red: x well above the zenith's and above 0.38.
   EXPECT_GT(X(sunward), X(zenith) + 0.08);
@@ -117,7 +118,7 @@ TEST(ClearSky, TwilightEarthShadow) {
   ColorEstimate zenith = sky.At(0, 0, 21);
   ColorEstimate sunward = sky.At(87, 0, 22);
   ColorEstimate antisun = sky.At(87, 180, 23);
-  std::printf("sun -4: zenith Y %.2f, sunward horizon Y %.2f, antisun horizon Y %.3f\n", zenith.xyz[1], sunward.xyz[1],
+  SKYBAKE_LOG("sun -4: zenith Y %.2f, sunward horizon Y %.2f, antisun horizon Y %.3f\n", zenith.xyz[1], sunward.xyz[1],
               antisun.xyz[1]);
   // Civil twilight at -4 deg: zenith 1-30 cd/m^2 (Rozenberg 1966; V-band twilight sky
   // brightness ~10-12 mag/arcsec^2 ~ 2-20 cd/m^2, Patat et al. 2006).

@@ -1,5 +1,5 @@
 // The `analytic` method (transport/method_analytic.h): the Cloud Party formulas
-// (../shared/seeds/cloudparty-sky-blog.txt) reproduced exactly, and their limits.
+// (the Cloud Party sky articles, part 2 of 3) reproduced exactly, and their limits.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -11,6 +11,7 @@
 #include <glm/geometric.hpp>
 
 #include "method_scenes.h"
+#include "support/log.h"
 #include "transport/method_ms_approx.h"
 #include "transport/method_single.h"
 
@@ -115,7 +116,7 @@ TEST(MethodMsApprox, IsotropicSecondOrderMatchesPathTracer) {
     const std::vector<ColorEstimate> ref = PathY(sc, sun_zenith, dirs, 0.004, 2);
     const std::vector<double> y = MethodY(sc, *method, sun_zenith, dirs);
     for (size_t d = 0; d < dirs.size(); ++d) {
-      std::printf("isotropic orders <= 2, sun %.0f dir %zu: ms-approx %.5g, path %.5g +- %.2g (%+.2f %%)\n", sun_zenith, d, y[d],
+      SKYBAKE_LOG("isotropic orders <= 2, sun %.0f dir %zu: ms-approx %.5g, path %.5g +- %.2g (%+.2f %%)\n", sun_zenith, d, y[d],
                   ref[d].xyz[1], ref[d].xyz_stderr[1], 100 * (y[d] / ref[d].xyz[1] - 1));
       EXPECT_NEAR(y[d], ref[d].xyz[1], 4 * ref[d].xyz_stderr[1] + 0.03 * ref[d].xyz[1]) << sun_zenith << " " << d;
     }
@@ -152,7 +153,7 @@ TEST(MethodMsApprox, ThinAndDenseAerosolAgainstPath) {
       worst = std::max(worst, std::abs(e));
     }
     const double rms = std::sqrt(ss / dirs.size()), rms1 = std::sqrt(ss1 / dirs.size());
-    std::printf("%s: ms-approx RMS %.3f worst %.3f; single RMS %.3f\n", c.atmosphere, rms, worst, rms1);
+    SKYBAKE_LOG("%s: ms-approx RMS %.3f worst %.3f; single RMS %.3f\n", c.atmosphere, rms, worst, rms1);
     EXPECT_LT(rms, c.max_rms) << c.atmosphere;
     EXPECT_GE(rms, c.min_rms) << c.atmosphere;
     EXPECT_LT(rms, rms1) << c.atmosphere;  // the approximation always helps in daylight

@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 
 #include "method_scenes.h"
+#include "support/log.h"
 #include "transport/method_single.h"
 #include "transport/single_scattering.h"
 #include "transport/sky_render.h"
@@ -101,7 +102,7 @@ TEST(MethodSingle, TransmittanceTableError) {
         }
       }
     }
-    std::printf("transmittance table %dx%d: worst |dT| = %.2e, worst |dtau| (T > 5 %%) = %.2e\n", c.n_mu, c.n_r,
+    SKYBAKE_LOG("transmittance table %dx%d: worst |dT| = %.2e, worst |dtau| (T > 5 %%) = %.2e\n", c.n_mu, c.n_r,
                 worst_dt, worst_rel);
     EXPECT_LT(worst_dt, c.max_dt) << c.n_mu << "x" << c.n_r;
     EXPECT_LT(worst_rel, c.max_rel_tau) << c.n_mu << "x" << c.n_r;
@@ -190,7 +191,7 @@ TEST(MethodSingle, MatchesSlowQuadrature) {
       worst = std::max(worst, std::abs(e));
       EXPECT_LT(std::abs(e), bound) << quality << " sun " << c.sun_zenith << " view " << c.view_zenith << "/" << c.azimuth;
     }
-    std::printf("single %s vs the slow quadrature: worst |dY/Y| = %.2e\n", quality.c_str(), worst);
+    SKYBAKE_LOG("single %s vs the slow quadrature: worst |dY/Y| = %.2e\n", quality.c_str(), worst);
   }
 }
 
@@ -222,7 +223,7 @@ TEST(MethodSingle, SunDiskQuadratureConverges) {
       worst = std::max(worst, std::abs(e));
       EXPECT_LT(std::abs(e), bound) << quality << " sun " << c.sun_zenith << " view " << c.view_zenith;
     }
-    std::printf("single %s disk vs 288 points: worst |dY/Y| = %.2e\n", quality.c_str(), worst);
+    SKYBAKE_LOG("single %s disk vs 288 points: worst |dY/Y| = %.2e\n", quality.c_str(), worst);
   }
 }
 

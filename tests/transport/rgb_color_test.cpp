@@ -10,6 +10,7 @@
 #include "spectrum/grid.h"
 #include "spectrum/solar.h"
 #include "spectrum/xyz.h"
+#include "support/log.h"
 #include "transport/rgb_color.h"
 
 using namespace skybake;
@@ -48,7 +49,7 @@ TEST(RgbColor, ExactForTheAssumedSpectralShape) {
 // [lambda, lambda + 10) interpolated at 680/550/440 nm) publishes
 //   SKY_SPECTRAL_RADIANCE_TO_LUMINANCE = (114974.916437, 71305.954816, 65310.548555)  (p = -3)
 //   SUN_SPECTRAL_RADIANCE_TO_LUMINANCE = (98242.786222, 69954.398112, 66475.012354)  (p = 0)
-// (../shared/notes/sky-methods.md §2.2). Ours differ by the solar normalisation (centred 10 nm
+// (atmosphere/model.cc ComputeSpectralRadianceToLuminanceFactors). Ours differ by the solar normalisation (centred 10 nm
 // bin means vs his interpolated bins) and the CMF interpolation: within 4 % (printed).
 TEST(RgbColor, CloseToBrunetonsConstants) {
   const TabulatedSpectrum solar = LoadSolarSpectrum(DefaultSolarPath());
@@ -59,7 +60,7 @@ TEST(RgbColor, CloseToBrunetonsConstants) {
   for (const auto& [p, ref] : {std::pair{-3.0, sky}, std::pair{0.0, sun}}) {
     std::array<double, 3> k{};
     RgbGridXyzWeights(cmf, solar, config, p, &k);
-    std::printf("p = %.0f: k = (%.1f, %.1f, %.1f), Bruneton (%.1f, %.1f, %.1f)\n", p, k[0], k[1], k[2], ref[0], ref[1], ref[2]);
+    SKYBAKE_LOG("p = %.0f: k = (%.1f, %.1f, %.1f), Bruneton (%.1f, %.1f, %.1f)\n", p, k[0], k[1], k[2], ref[0], ref[1], ref[2]);
     for (size_t c = 0; c < 3; ++c) EXPECT_NEAR(k[c] / ref[c], 1.0, 0.04) << "p " << p << " channel " << c;
   }
 }

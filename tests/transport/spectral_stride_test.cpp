@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "method_scenes.h"
+#include "support/log.h"
 #include "transport/sky_method.h"
 #include "transport/spectral_stride.h"
 
@@ -87,7 +88,7 @@ TEST(SpectralStride, ExactAtNodesAndSmallBetween) {
       worst_uv = std::max(worst_uv, std::hypot(u(1) - u(0), v(1) - v(0)));
     }
     const double rms = std::sqrt(se / static_cast<double>(Dirs().size()));
-    std::printf("stride 2 on 10 nm, sun %.0f: Y RMS %.3f %%, max %.3f %%, du'v' max %.5f\n", sza, 100 * rms, 100 * worst, worst_uv);
+    SKYBAKE_LOG("stride 2 on 10 nm, sun %.0f: Y RMS %.3f %%, max %.3f %%, du'v' max %.5f\n", sza, 100 * rms, 100 * worst, worst_uv);
     EXPECT_LT(rms, 0.004);
     EXPECT_LT(worst, 0.012);
     EXPECT_LT(worst_uv, 0.003);

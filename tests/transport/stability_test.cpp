@@ -13,6 +13,7 @@
 #include <glm/geometric.hpp>
 
 #include "method_scenes.h"
+#include "support/log.h"
 #include "transport/method_single.h"
 
 using namespace skybake;
@@ -75,7 +76,7 @@ TEST(Stability, SingleScatteringAtTwilight) {
     const std::vector<Ref> ref = Path(sc, c.elevation, zenith, c.target, uint64_t{1} << 18);
     const double y = Method(sc, "single", "medium", c.elevation, zenith)[0];
     const double e = y / ref[0].y - 1.0;
-    std::printf("single, zenith, sun %+.0f deg: %.4g vs path %.4g +- %.1f %% -> %+.1f %%\n", c.elevation, y, ref[0].y,
+    SKYBAKE_LOG("single, zenith, sun %+.0f deg: %.4g vs path %.4g +- %.1f %% -> %+.1f %%\n", c.elevation, y, ref[0].y,
                 100 * ref[0].se / ref[0].y, 100 * e);
     EXPECT_GT(e, c.lo) << c.elevation;
     EXPECT_LT(e, c.hi) << c.elevation;
@@ -102,7 +103,7 @@ TEST(Stability, MsApproxWithDenseAerosols) {
     double ss = 0.0;
     for (size_t d = 0; d < dirs.size(); ++d) ss += std::pow(y[d] / ref[d].y - 1.0, 2);
     const double rms = std::sqrt(ss / dirs.size());
-    std::printf("ms-approx, %s tau %g: RMS %.1f %%\n", c.atmosphere, c.tau, 100 * rms);
+    SKYBAKE_LOG("ms-approx, %s tau %g: RMS %.1f %%\n", c.atmosphere, c.tau, 100 * rms);
     EXPECT_GT(rms, c.lo) << c.atmosphere << " " << c.tau;
     EXPECT_LT(rms, c.hi) << c.atmosphere << " " << c.tau;
     EXPECT_GT(rms, prev);  // grows with the aerosol load
@@ -120,7 +121,7 @@ TEST(Stability, MsApproxLutInTwilight) {
   const std::vector<Ref> ref = Path(sc, -4, zenith, 0.04, uint64_t{1} << 18);
   const double medium = Method(sc, "ms-approx", "medium", -4, zenith)[0] / ref[0].y - 1.0;
   const double high = Method(sc, "ms-approx", "high", -4, zenith)[0] / ref[0].y - 1.0;
-  std::printf("ms-approx at -4 deg, zenith: medium %+.1f %%, high %+.1f %% (path +- %.1f %%)\n", 100 * medium, 100 * high,
+  SKYBAKE_LOG("ms-approx at -4 deg, zenith: medium %+.1f %%, high %+.1f %% (path +- %.1f %%)\n", 100 * medium, 100 * high,
               100 * ref[0].se / ref[0].y);
   EXPECT_GT(medium, 0.3);
   EXPECT_LT(std::abs(high), 0.15);
@@ -138,7 +139,7 @@ TEST(Stability, AnalyticNearTheHorizon) {
   for (const char* q : {"low", "medium"}) {
     const std::vector<double> y = Method(sc, "analytic", q, 0, dirs);
     const double ez = y[0] / ref[0].y - 1.0, eh = y[1] / ref[1].y - 1.0;
-    std::printf("analytic %s, sun 0 deg: zenith %+.0f %%, sunward horizon %+.0f %%\n", q, 100 * ez, 100 * eh);
+    SKYBAKE_LOG("analytic %s, sun 0 deg: zenith %+.0f %%, sunward horizon %+.0f %%\n", q, 100 * ez, 100 * eh);
     EXPECT_LT(std::abs(ez), 0.6) << q;
     EXPECT_GT(eh, 1.0) << q;
   }
@@ -198,7 +199,7 @@ TEST(Stability, MiePeakSharperThanTheAngularGrid) {
     double worst = 0.0;
     for (size_t d = 0; d < dirs.size(); ++d) {
       const double e = y[d] / y0[d] - 1.0;
-      std::printf("phase on a %.1f deg grid, %.1f deg from the sun: %+.1f %%\n", c.step_deg, std::acos(dirs[d][2]) / kDeg - 60, 100 * e);
+      SKYBAKE_LOG("phase on a %.1f deg grid, %.1f deg from the sun: %+.1f %%\n", c.step_deg, std::acos(dirs[d][2]) / kDeg - 60, 100 * e);
       worst = std::max(worst, std::abs(e));
     }
     EXPECT_LT(worst, c.max_fine) << c.step_deg;

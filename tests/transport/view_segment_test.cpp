@@ -164,7 +164,7 @@ TEST(ViewSegment, OrdersUnlimitedSegmentIsTheSky) {
     for (size_t i = 0; i < dirs.size(); ++i) {
       // 2 deg above the horizon the table's interpolation in view angle differs from the
       // march through the source by up to 1.1 % (measured at quality low); since the table rays
-      // weight their steps by the single-scattering albedo (energy-conserving, 2026-11-23) and
+      // weight their steps by the single-scattering albedo (energy-conserving) and
       // the march by the point's sigma_s*, up to 2.1 % there and 0.55 % 45 deg up (sun 80 deg).
       const double tol = i == 4 ? 0.025 : 7e-3;
       EXPECT_NEAR(sc.Y(&Ls[i * nw]), sc.Y(&L[i * nw]), tol * sc.Y(&L[i * nw])) << sun_deg << " dir " << i;

@@ -1,4 +1,4 @@
-"""The runtime viewer (viewer/, issue 27) in a real browser: Debian's Chromium, headless, with
+"""The runtime viewer (viewer/) in a real browser: Debian's Chromium, headless, with
 software WebGL2 (SwiftShader), driven by puppeteer-core (tests/viewer/drive.mjs) against a
 reduced bake served on 127.0.0.1 by scripts/view_server.py.
 

@@ -1,5 +1,5 @@
-// fog-fit edges: GT7 global fog of the basis skies (docs/fog.md; ../shared/seeds/gt7-sky-talk.txt,
-// "Fog").
+// fog-fit edges: GT7 global fog of the basis skies (docs/fog.md; GT7 sky
+// talk, "Fog").
 //
 //   outputs/<atm>/fog.exr             sky-render fog: the reference fog of the low atmosphere (LUT
 //                                     slices, depth tables, attenuation nodes) of one basis sky

@@ -1,6 +1,6 @@
 // The layered, spherically symmetric atmosphere as the renderers see it: optical coefficients
 // of each constituent on the altitude levels and the wavelength grid, their phase functions, the
-// Lambertian ground and the sun (design.md §4; Bruneton & Neyret 2008 §2.1).
+// Lambertian ground and the sun (docs/atmosphere.md; Bruneton & Neyret 2008 §2.1).
 //
 // Coefficients are tabulated per level (the profile grid of profile-import) and wavelength, in
 // m^-1, and are *linear in altitude between levels* (which is also what makes the trapezoid rule

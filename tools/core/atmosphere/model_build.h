@@ -1,4 +1,4 @@
-// Builds the renderers' AtmosphereModel from measured inputs (design.md §4):
+// Builds the renderers' AtmosphereModel from measured inputs (docs/atmosphere.md):
 //   air     n_air(z) sigma_R(lambda)  (optics/rayleigh.h, Bodhaine 1999), depolarised Rayleigh phase
 //   ozone   n_O3(z) sigma_O3(lambda, T(z))  (Bogumil et al. 2003 fit at the local temperature,
 //           or a fixed table), absorption only

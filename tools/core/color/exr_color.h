@@ -3,8 +3,7 @@
 //
 //   CIE-XYZ-D65            X, Y, Z in R, G, B; chromaticities red (1,0), green (0,1), blue (0,0),
 //                          white (1/3, 1/3) (io/exr.h XyzChromaticities, the convention of
-//                          OpenEXR's Chromaticities/XYZ.exr test image; ../shared/notes/
-//                          ninja-ocio-exr-ktx.md §3): XYZ not adapted, E is where R = G = B.
+//                          OpenEXR's Chromaticities/XYZ.exr test image): XYZ not adapted, E is where R = G = B.
 //   Linear Rec.2020        ITU-R BT.2020 primaries, white D65 (0.3127, 0.3290)
 //   Linear Rec.709 (sRGB)  ITU-R BT.709 primaries, white D65 (OpenEXR's default)
 // Other spaces (the CIE 2006 observer's XYZ, ACES2065-1, display spaces) are refused: convert to

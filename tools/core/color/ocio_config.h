@@ -1,6 +1,6 @@
 // The OpenColorIO config of skybake, built from code (tools/ocio-config-gen writes it to
 // ocio/config.ocio; docs/color.md §6). OCIO 2.1 has no built-in configs
-// (../shared/notes/ninja-ocio-exr-ktx.md §2.1), so skybake ships its own.
+// (they are 2.2+: OpenColorIO's 2.2 release notes), so skybake ships its own.
 //
 // Reference: CIE-XYZ-D65, scene-linear, absolute (Y in cd/m² for the renderer's output). It is
 // CIE 1931 2° XYZ with no chromatic adaptation; "D65" names the encodings' white, not an

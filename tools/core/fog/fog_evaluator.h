@@ -1,6 +1,6 @@
 // The reference evaluator of fog-fit's products: the runtime math a shader does to rebuild GT7's
 // global fog for any view direction, object depth and sun angle from the packed LUTs and the
-// fitted parameters (docs/fog.md, "Evaluator"; ../shared/seeds/gt7-sky-talk.txt, "Fog").
+// fitted parameters (docs/fog.md, "Evaluator"; GT7 sky talk, "Fog").
 //
 //   mu     = the view direction's zenith cosine, clamped to [0, 1] (below the horizon: the horizon's
 //            geometry, fog/fog_model.h); the LUTs are read at the direction itself (their texels

@@ -1,6 +1,6 @@
 // The fit of GT7's depth function (fog/fog_model.h): a and p of
 //   Fog(dir, x) / Fog(dir, 1) = F(x, a theta^p) = (1 - exp(-a theta^p x)) / (1 - exp(-a theta^p))
-// over every direction and depth of the reference fog (../shared/seeds/gt7-sky-talk.txt, "Global
+// over every direction and depth of the reference fog (GT7 sky talk, "Global
 // Fog Approximation": "a and p were fitted using reference fog results for all directions and
 // depths"), by nonlinear least squares (Eigen's Levenberg-Marquardt, MINPACK's lmder; Moré 1978).
 //

@@ -1,5 +1,5 @@
 // GT7's global fog model: the runtime math that rebuilds fog from a direction-only LUT and two
-// fitted parameters (../shared/seeds/gt7-sky-talk.txt, "Fog", "Global Fog Approximation",
+// fitted parameters (GT7 sky talk, "Fog", "Global Fog Approximation",
 // "Global Fog Problem (1)/(2)"; docs/fog.md has the derivations and the measured errors).
 //
 // Geometry (local frame of lut/directions.h: +z zenith). The observer is at radius

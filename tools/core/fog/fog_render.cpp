@@ -533,7 +533,7 @@ FogRender ReadFogRender(const fs::path& path) {
   if (static_cast<int>(slices.size()) != r.time.slices()) {
     fail(fmt::format("{} fog LUT slices, but the time mapping '{}' has {}", slices.size(), r.time_mapping_name, r.time.slices()));
   }
-  // The texel grid is part of the mapping's description (renders before the node grid: centres).
+  // The texel grid (centres or nodes) is part of the mapping's description: read it from there.
   const std::string* first_mapping = StringAttr(first, "skybake.mapping");
   for (gt7::TexelGrid g : {gt7::TexelGrid::kCentres, gt7::TexelGrid::kNodes}) {
     if (first_mapping && *first_mapping == gt7::Gt7SkyMapping(r.lut_width, r.lut_height, r.sphere, g).Describe()) r.texel_grid = g;

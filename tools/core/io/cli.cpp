@@ -3,6 +3,7 @@
 #include <spdlog/sinks/stdout_sinks.h>
 #include <spdlog/spdlog.h>
 #include <tbb/global_control.h>
+#include <tbb/task_arena.h>
 
 #include <chrono>
 #include <cmath>
@@ -91,10 +92,15 @@ int ToolCli::Run(int argc, char** argv, const std::function<void()>& body) {
     int code = app_.exit(e);
     return code == 0 ? 0 : 2;
   }
+  // --threads N runs the body on exactly N worker threads, also where N exceeds the cores: the
+  // control lifts TBB's worker cap (the core count) to N and an arena of N slots runs the body
+  // (either alone gives one thread on a one-core machine). N = 0: TBB's default, all cores.
   std::unique_ptr<tbb::global_control> threads_control;
+  std::unique_ptr<tbb::task_arena> arena;
   if (threads_ > 0) {
     threads_control = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                             static_cast<size_t>(threads_));
+    arena = std::make_unique<tbb::task_arena>(threads_);
   }
   // One output transaction per command (io/fileio.h): the body's files become visible together
   // when it succeeds, and none of them when it throws.
@@ -107,7 +113,11 @@ int ToolCli::Run(int argc, char** argv, const std::function<void()>& body) {
   } transaction;
   try {
     CheckFiniteOptions(&app_);
-    body();
+    if (arena) {
+      arena->execute(body);
+    } else {
+      body();
+    }
     CommitOutputTransaction();
     transaction.done = true;
     return 0;

@@ -1,4 +1,5 @@
-// The one command-line contract of every skybake tool (style.md §6, docs/cli.md):
+// The one command-line contract of every skybake tool (docs/developing.md, "CLI contract (every
+// tool)"):
 //   --help            usage on stdout, exit 0
 //   --version         "<tool> (skybake) <version>" on stdout, exit 0
 //   --threads N       worker threads (0 = all cores); outputs do not depend on N

@@ -2,7 +2,7 @@
 //
 // The library never prints and never exits: it throws one of these, and each tool's main
 // catches once (io/cli.h) and turns it into `tool: file:line: message` and an exit code
-// (style.md §7):
+// (docs/developing.md "Rules", 6):
 //   InputError    - the user's input is wrong (bad YAML/CSV/EXR, out-of-range value, missing
 //                   file). Exit code 1. Carries one or more located diagnostics, so a loader can
 //                   report every problem of a file at once.

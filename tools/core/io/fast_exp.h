@@ -7,8 +7,8 @@
 
 namespace skybake {
 
-// std::exp / expf are library calls GCC does not vectorise without -ffast-math; in the `orders`
-// render they were 18 % of a LUT (one per wavelength per view-ray point, the sun transmittance's
+// std::exp / expf are library calls GCC does not vectorise without -ffast-math; with them the
+// `orders` render spends 18 % of a LUT in exp (one per wavelength per view-ray point, the sun transmittance's
 // logarithmic blend). Range reduction x = n ln2 + r, |r| <= ln2 / 2, n = round(x / ln2) by the
 // 1.5 x 2^23 rounding trick, ln2 in two parts (Cody & Waite 1980, "Software Manual for the
 // Elementary Functions": the upper part has 12 significant bits, so n ln2_hi is exact for
@@ -35,7 +35,7 @@ inline float ExpF(float x) {
   // The biased exponent clamped to 0 (the result is 0) ... 255 (inf). No float comparison here:
   // GCC turned a clamp of x into branches to the clamped constant, which stopped vectorisation.
   // n is first limited to [-256, 256] (a NaN to -256), so that the conversion to int is defined for
-  // every x (NaN and |x| > 2^31 ln 2 included): the result is then 0, inf or NaN as before.
+  // every x (NaN and |x| > 2^31 ln 2 included): the result is then 0, inf or NaN, as the unlimited formula gives.
   const float n_limited = !(n >= -256.0f) ? -256.0f : (n > 256.0f ? 256.0f : n);
   const int32_t e = std::min(std::max(static_cast<int32_t>(n_limited) + 127, int32_t{0}), int32_t{255});
   return p * std::bit_cast<float>(e << 23);

@@ -1,4 +1,4 @@
-// Files the way Ninja needs them (style.md §8, notes/ninja-ocio-exr-ktx.md §1):
+// Files the way Ninja needs them (docs/developing.md "Rules", 7; Ninja manual, "restat"):
 //  - WriteFileIfChanged: the whole content is prepared in memory first, compared with what is
 //    on disk, and only when it differs written to a temporary file in the same folder, flushed
 //    (fsync) and renamed over the target. A crash or SIGKILL at any moment leaves either the old

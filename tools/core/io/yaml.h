@@ -5,7 +5,7 @@
 //   file.yaml:3: missing key 'planet.radius_km': expected a positive number in km
 //   file.yaml:7: unknown key 'planet.radius_kn' (did you mean 'radius_km'?)
 //   file.yaml:9: duplicate key 'planet.top_km' (first given on line 8)
-// Problems are collected in the document's Diagnostics and reported together (style.md §4):
+// Problems are collected in the document's Diagnostics and reported together (docs/developing.md "Rules", 4):
 // a loader reads everything, falling back to neutral values where a value is bad, and calls
 // YamlDocument::ThrowIfErrors() once at the end.
 //

@@ -1,8 +1,8 @@
 // DirectDraw Surface (DDS) files with the DX10 header extension, written (and read back) by hand,
 // for the Direct3D side of the LUTs (DXGI_FORMAT_R11G11B10_FLOAT). Layout, from Microsoft's
 // "Programming Guide for DDS" (learn.microsoft.com/windows/win32/direct3ddds/dx-graphics-dds-pguide),
-// "DDS_HEADER structure", "DDS_PIXELFORMAT structure" and "DDS_HEADER_DXT10 structure"
-// (notes/ninja-ocio-exr-ktx.md §4.3), all little-endian:
+// "DDS_HEADER structure", "DDS_PIXELFORMAT structure" and "DDS_HEADER_DXT10 structure",
+// all little-endian:
 //
 //   offset  0  dwMagic "DDS " (0x20534444)
 //   offset  4  DDS_HEADER (124 bytes): dwSize = 124, dwFlags, dwHeight, dwWidth,

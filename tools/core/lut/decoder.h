@@ -1,6 +1,6 @@
 // The reference decoder of lut-pack's sky LUTs (docs/lut-pack.md, "Decoding"): the math a shader
 // does to rebuild the sky radiance for any sun zenith angle and any view direction from a packed
-// GT7 LUT (../shared/seeds/gt7-sky-talk.txt, "Adaptive Mapping of LUT (spherical direction)":
+// GT7 LUT (GT7 sky talk, "Adaptive Mapping of LUT (spherical direction)":
 // "interpolation between different LUT (time) slices is possible", "it can be decoded as a sky for
 // any sun elevation").
 //

@@ -1,6 +1,6 @@
-// GT7's adaptive sky LUT mappings (../shared/seeds/gt7-sky-talk.txt, "Adaptive Mapping of LUT
+// GT7's adaptive sky LUT mappings (GT7 sky talk, "Adaptive Mapping of LUT
 // (time component)", "(spherical direction)", "Detail of Adaptive Mapping", "Concept Code";
-// ../shared/design.md §6; docs/lut-pack.md has the derivations and the decisions).
+// docs/lut-pack.md has the derivations and the decisions).
 //
 // TIME (sun zenith angle theta_z per slice; 64 slices = 48 upper + 16 lower in GT7):
 //   upper region, i = 0 .. Nu-1:  d_i = lerp(d_min, d_max, (i / (Nu - 1))^p), with d_min = R - r the

@@ -1,8 +1,7 @@
 // KTX 2.0 containers for GPU textures, written (and read back) by hand.
 //
-// Debian 12 packages no libktx, so skybake writes KTX2 itself (../shared/notes/ninja-ocio-exr-ktx.md
-// §4). Everything here follows the KTX File Format Specification 2.0 (KhronosGroup/KTX-Specification
-// ktxspec.adoc, "File Structure", "Data Format Descriptor", "Key/Value Data") and the Khronos Data
+// Debian 12 packages no libktx, so skybake writes KTX2 itself. Everything here follows the KTX
+// File Format Specification 2.0 (KhronosGroup/KTX-Specification ktxspec.adoc, "File Structure", "Data Format Descriptor", "Key/Value Data") and the Khronos Data
 // Format Specification 1.3 basic descriptor block (the layout KTX-Software's lib/dfdutils writes):
 //
 //   identifier «KTX 20»\r\n\x1A\n (12 bytes)
@@ -148,7 +147,8 @@ Format R16G16B16A16Sfloat();
 Format R32Sfloat();
 Format R32G32B32A32Sfloat();
 // VK_FORMAT_B10G11R11_UFLOAT_PACK32 (122): R in bits 0-10, G in 11-21, B in 22-31, unsigned
-// floats; typeSize 4; DFD values as listed in notes/ninja-ocio-exr-ktx.md §4.2 (vk2dfd.inl).
+// floats; typeSize 4; DFD values as KTX-Software lib/dfdutils writes them (vk2dfd.inl,
+// createdfd.c).
 // The texel packing itself belongs to lut-pack.
 Format B10G11R11UfloatPack32();
 // The Format for a vkFormat above; throws InternalError for any other value.

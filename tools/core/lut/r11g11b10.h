@@ -1,6 +1,6 @@
 // R11G11B10F ("B10G11R11_UFLOAT_PACK32" in Vulkan, "R11G11B10_FLOAT" in DXGI): three unsigned
 // floats in one little-endian 32-bit word, the texel format of GT7's sky LUTs
-// (../shared/seeds/gt7-sky-talk.txt, "Single Look-up Table Texture": "Texture format
+// (GT7 sky talk, "Single Look-up Table Texture": "Texture format
 // R11F_G11F_B10F; BC6h is not sufficient for color accuracy").
 //
 // Layout (Vulkan spec, "Packed Formats" / VK_FORMAT_B10G11R11_UFLOAT_PACK32; Khronos Data Format
@@ -16,8 +16,8 @@
 // Largest finite value: 2^15 (2 - 2^-M) = 65024 (11-bit), 64512 (10-bit); smallest normal 2^-14
 // = 6.1e-5; smallest denormal 2^-20 = 9.5e-7 (11-bit), 2^-19 = 1.9e-6 (10-bit).
 //
-// Our packer (notes/ninja-ocio-exr-ktx.md §4.4 explains why not GLM's packF2x11_1x10, which
-// truncates and has no range checks, nor float -> half -> 11 bits, which rounds twice):
+// Our packer (not GLM 0.9.9.8's packF2x11_1x10, which truncates and has no range checks,
+// g-truc/glm #602; nor float -> half -> 11 bits, which rounds twice):
 //   - rounds the float32 directly to the nearest code, ties to the even code (IEEE 754-2008
 //     §4.3.1 roundTiesToEven), denormals included;
 //   - negative values, -0 and NaN give 0 (the format has no sign; a negative Rec.2020 component is

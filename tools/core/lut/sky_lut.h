@@ -1,5 +1,5 @@
 // lut-pack's core (docs/lut-pack.md): sky-render products on the GT7 mappings -> the runtime
-// textures GT7 ships (../shared/seeds/gt7-sky-talk.txt, "Run-time Sky Rendering Method",
+// textures GT7 ships (GT7 sky talk, "Run-time Sky Rendering Method",
 // "Memory Budget of Look-up Table", "Other Look-up Tables"):
 //
 //   sky LUT per basis sky   W x H x N texels (N sun-elevation slices of the GT7 time mapping, the

@@ -2,7 +2,7 @@
 // indexed by the cumulus map's density (x) and altitude (y) that turns the 2D map into a 3D
 // density together with the noise volumes.
 //
-// GT7 sky talk, "Coverage Texture" (../shared/seeds/gt7-sky-talk.txt): "2D texture, resolution
+// GT7 sky talk, "Coverage Texture": "2D texture, resolution
 // 256 * 128, hand crafted values ... fetch values according to 2D density and altitude, then
 // combine with frequency components ... 4 components packed into RGBA: height modulation,
 // low-frequency, mid-frequency, ambient lighting". Frostbite's cloud-type texture (Hillaire 2016

@@ -2,10 +2,10 @@
 // with more texels near the world centre, sampled from a stationary weather field that the wind
 // carries along.
 //
-// GT7 sky talk, "Modeling of Clouds" (../shared/seeds/gt7-sky-talk.txt): "2D texture (256 * 256),
+// GT7 sky talk, "Modeling of Clouds": "2D texture (256 * 256),
 // 240 km * 240 km, nonlinear texel distribution optimizations ... supplied by weather sim ...
 // based on Perlin noise ... advected by the wind"; "the more central the world, the more texels".
-// Frostbite's weather texture (Hillaire 2016 §5.3.1, ../shared/seeds/hillaire2016-...txt) holds
+// Frostbite's weather texture (Hillaire 2016 §5.3.1) holds
 // the same two quantities: "Red: 2d projected cloud density, Green: cloud type".
 //
 // World frame: x east, y north, metres, origin at the world centre. Texture frame: texel (i, j),

@@ -39,7 +39,7 @@ class PeriodicGradientNoise3 {
 // Tileable 3D cellular noise: F1, the distance to the nearest feature point (Worley 1996,
 // "A Cellular Texture Basis Function", SIGGRAPH '96, 291-294), with exactly one feature point per
 // lattice cell as in Schneider 2015 ("The real-time volumetric cloudscapes of Horizon Zero Dawn",
-// SIGGRAPH Advances) and Hillaire 2016 §5.4 (../shared/seeds/hillaire2016-frostbite-sky-clouds.txt):
+// SIGGRAPH Advances) and Hillaire 2016 §5.4 ("Cloud noise"):
 //   point(c) = c + 1/2 + jitter (u(c) - 1/2),  u(c) uniform in [0,1)^3 hashed from c mod period,
 //   F1(p)    = min_c |p - point(c)|   (lattice units; periodic: F1(p + period e_k) = F1(p)).
 // Worley's original scatters a Poisson number of points per cell; one point per cell keeps the

@@ -1,10 +1,10 @@
 // Tileable cloud noise volumes (noise-gen): the GT7 low- and high-frequency textures and a
 // Frostbite/Horizon-style RGBA shape texture, from a YAML recipe (docs/clouds.md).
 //
-// Sources: GT7 sky talk, "Modeling of Clouds" (../shared/seeds/gt7-sky-talk.txt): low frequency
+// Sources: GT7 sky talk, "Modeling of Clouds": low frequency
 // 128^3 Perlin-inverted Worley, ~5 km, normalised to zero mean "so the amount of clouds does not
 // vary with the intensity of the noise"; high frequency 32^3 Worley, ~300 m. Hillaire 2016 §5.4
-// (../shared/seeds/hillaire2016-frostbite-sky-clouds.txt) and Schneider 2015 ("The real-time
+// ("Cloud noise") and Schneider 2015 ("The real-time
 // volumetric cloudscapes of Horizon Zero Dawn", SIGGRAPH Advances): Perlin-Worley base shape and
 // Worley octaves, stored as RGBA.
 //

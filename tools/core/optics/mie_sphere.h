@@ -22,7 +22,7 @@
 // xi_n = psi_n - i chi_n = x h_n^(1)(x), the logarithmic derivative D_n(z) = psi_n'(z)/psi_n(z),
 // and the angular functions pi_n = P_n^1(mu)/sin(theta), tau_n = dP_n^1(cos theta)/d theta.
 //
-// Numerics, and why (notes: ../shared/notes/mie-numerics.md §1):
+// Numerics, and why (the source of each is named in its item):
 //   - Number of terms: Wiscombe's criterion (Wiscombe 1980, Appl. Opt. 19, 1505, eq. R50 of
 //     MIEV0): N = x + 4 x^(1/3) + 1 (x <= 8), x + 4.05 x^(1/3) + 2 (8 < x < 4200),
 //     x + 4 x^(1/3) + 2 (x >= 4200); never fewer than 2 terms, because for a Rayleigh-size sphere

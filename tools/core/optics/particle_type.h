@@ -14,7 +14,7 @@
 //       weight: {relative_volume: 1.0} # number_density_cm3 | relative_number |
 //                                      # volume_um3_per_cm3 | relative_volume (same key in every mode)
 //
-// The log-normal family (notes/mie-numerics.md §3.1; Hansen & Travis 1974, Space Sci. Rev. 16,
+// The log-normal family (Hansen & Travis 1974, Space Sci. Rev. 16,
 // 527, eqs. 2.53-2.56): with s = ln sigma_g and r_g the number median radius,
 //   dN/dln r = N / (sqrt(2 pi) s) exp(-(ln r - ln r_g)^2 / (2 s^2)),
 //   volume median r_V = r_g e^{3 s^2},  effective radius r_eff = <r^3>/<r^2> = r_g e^{5 s^2 / 2},

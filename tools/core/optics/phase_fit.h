@@ -1,5 +1,5 @@
 // Simple phase-function models and their best fits to a tabulated (Mie) phase function, to
-// measure what a renderer loses by using them (the GT7 talk, ../shared/seeds/gt7-sky-talk.txt,
+// measure what a renderer loses by using them (GT7 sky talk,
 // "Real Earth Atmosphere" -> "Aerosols" -> "Phase Function Approximation": HG "can never fit
 // well enough ... the error would be more than 16 times in the coarse-mode forward scattering").
 //

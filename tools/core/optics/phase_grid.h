@@ -3,7 +3,7 @@
 // Size-averaged aerosol phase functions have a forward peak about 1/x rad wide (x = 2 pi r /
 // lambda; 0.07 deg at x = 900, a 50 um droplet in violet light) with a diffraction tail falling
 // like theta^-3, and values that span 6 to 9 decades between 0 and 180 deg
-// (notes/mie-numerics.md §1.5). The grid therefore is
+// (Wiscombe, MIEV.doc L436-456). The grid therefore is
 //   theta = 0,
 //   400 angles log-spaced from 0.01 deg to 5 deg (ratio 1.0157 between neighbours: ~200 points
 //     inside the first diffraction minimum 3.83/x rad for any x <= 1000, and the tail resolved),

@@ -6,7 +6,7 @@
 //   <C_ext> = int pi r^2 Q_ext(x, m) n(u) du       (same for sca, abs; g C_sca with g Q_sca)
 //   <dC_sca/dOmega>(theta) = int i(theta; x, m) / k^2 n(u) du,   i = (|S1|^2 + |S2|^2)/2
 // Modes combine by number fraction f_i (Wiscombe, MIEV.doc L345-371: integrate cross sections and
-// intensities, never Q, albedo, g or the normalised P; notes/mie-numerics.md §3.4):
+// intensities, never Q, albedo, g or the normalised P; Mishchenko, Travis & Lacis 2002, eqs 5.242-5.250):
 //   <C> = sum f_i <C>_i,  omega = <C_sca>/<C_ext>,  g = sum f_i <g C_sca>_i / <C_sca>,
 //   P(theta) = sum f_i <dC_sca/dOmega>_i / <C_sca>    (integral 1 over the sphere).
 //

@@ -4,8 +4,8 @@
 //   Observer::kCie2006_2deg (default): the CIE 2006 / CIE 170-2 "physiologically relevant" 2°
 //     XYZ CMFs, linear transformations of the CIE 2006 2° LMS cone fundamentals (CVRL
 //     "lin2012xyz2e", cvrl.org; atmospheres/data/cie2006_2deg_xyz_cmf_1nm.csv, 390-830 nm at
-//     1 nm). The GT7 sky talk uses them (../shared/seeds/gt7-sky-talk.txt, "CIE (2006) 2-deg
-//     Color Matching Function"). Their ȳ is the CIE 2008 physiologically relevant luminous
+//     1 nm). The GT7 sky talk uses them ("CIE (2006) 2-deg Color Matching
+//     Function"). Their ȳ is the CIE 2008 physiologically relevant luminous
 //     efficiency function V_F(λ), not the SI V(λ) of 1924 (docs/color.md §3.2).
 //     CVRL (cvrl.ioo.ucl.ac.uk/ciexyzpr.htm): "The official CIE definition is the version
 //     provided at 1-nm steps. At this stepsize, the three CMFs have precisely equal integrals, and

@@ -69,7 +69,7 @@ WavelengthGrid WavelengthGrid::List(std::vector<double> wavelengths_nm, const Fi
 WavelengthGrid WavelengthGrid::Rgb() {
   WavelengthGrid g;
   g.kind_ = Kind::kRgb;
-  // Red, green, blue: Hillaire 2016 (../shared/seeds/hillaire2016-frostbite-sky-clouds.txt,
+  // Red, green, blue: Hillaire 2016 (§2.1,
   // "red (680nm), green (550nm) and blue (440nm)"), Bruneton & Neyret 2008 §2.1 (680, 550, 440 nm).
   g.wavelength_nm_ = {680.0, 550.0, 440.0};
   for (double w : g.wavelength_nm_) {

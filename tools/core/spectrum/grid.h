@@ -17,7 +17,7 @@
 //     A one-sample uniform grid (min = max) has the bin [λ - h/2, λ + h/2].
 //
 //   the "RGB" grid {680, 550, 440} nm (R, G, B order, as Bruneton & Neyret 2008 §2.1 and
-//     Hillaire 2016 §2.1 use for three-channel models; ../shared/notes/sky-methods.md §2.2):
+//     Hillaire 2016 §2.1 use for three-channel models; Bruneton 2017 demo.cc):
 //     not a quadrature grid. Its
 //     values are the three channels of a simplified model, read as Linear Rec.709 (sRGB)
 //     (docs/color.md §5). Its bins are 10 nm wide, centred ([675, 685], [545, 555],

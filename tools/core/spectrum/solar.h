@@ -6,7 +6,7 @@
 // atmospheres/data/astm_g173_03_solar_spectrum.csv, column extraterrestrial_W_m2_nm. ASTM gives
 // 1366.1 W/m² for the whole spectrum; the tabulated 280-4000 nm hold 1347.9 W/m² (trapezoid), the
 // rest lies beyond 4 µm (tests/spectrum/solar_test.cpp checks this against Planck's law).
-// The GT7 sky renderer uses the same table (../shared/seeds/gt7-sky-talk.txt, "ASTM G173-03
+// The GT7 sky renderer uses the same table (GT7 sky talk, "ASTM G173-03
 // Extraterrestrial Spectrum").
 //
 // On a grid it is bin-averaged wherever the table resolves the bins (spectrum.h kAuto): on a 5 nm

@@ -27,7 +27,7 @@
 namespace skybake {
 
 struct AmbientQuadrature {
-  bool sun_cap = true;        // false: the grid alone (the quadrature until 2026-11-24)
+  bool sun_cap = true;        // false: the sphere grid alone, no cap around the sun
   double cap_flat_deg = 10.0; // W = 1 up to here from the sun ...
   double cap_deg = 30.0;      // ... and 0 from here on (raised cosine between)
   int cap_psi = 8;            // cap azimuths over the half-circle around the sun

@@ -1,5 +1,5 @@
 // The `analytic` sky method: the Cloud Party approximation (the Cloud Party sky articles on
-// Gamasutra, part 2 of 3; ../shared/seeds/cloudparty-sky-blog.txt), a real-time shader's
+// Gamasutra, part 2 of 3, "Improved Implementation"), a real-time shader's
 // single scattering in a *constant-density* atmosphere shell, applied to the model's own
 // coefficients and phase functions (docs/sky-methods.md, "analytic").
 //

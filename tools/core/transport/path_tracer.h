@@ -1,5 +1,5 @@
 // The reference renderer: a spectral Monte-Carlo path tracer for the layered spherical
-// atmosphere (GT7 "skysim" class; ../shared/seeds/gt7-sky-talk.txt, "Skysim": full-spectrum
+// atmosphere (GT7 "skysim" class; GT7 sky talk, "Skysim": full-spectrum
 // path tracing, ratio tracking, importance sampling).
 //
 // Estimator (docs/sky-render.md has the derivation):

@@ -3,7 +3,7 @@
 // spectral renders (docs/sky-methods.md, "RGB"; docs/color.md §5).
 //
 // Bruneton 2017's rule (model.cc ComputeSpectralRadianceToLuminanceFactors, "Bruneton 2016
-// §14.3"; ../shared/notes/sky-methods.md §2.2): each channel's radiance L_c at lambda_c stands for
+// §14.3"): each channel's radiance L_c at lambda_c stands for
 // a whole spectrum of the shape of the solar spectrum times lambda^p, scaled to pass through L_c,
 //   L(lambda) ~ L_c E_0(lambda)/E_0(lambda_c) (lambda/lambda_c)^p,
 // and contributes that spectrum's Linear Rec.709 channel c:
