@@ -9,6 +9,11 @@
 #include <filesystem>
 #include <thread>
 
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfOutputFile.h>
+
 #include "io/error.h"
 #include "io/exr.h"
 #include "io/fileio.h"
@@ -255,6 +260,35 @@ TEST(Exr, HeaderFieldsTheFileCannotHoldAreRefusedBeforeDecoding) {
 
   EXPECT_EQ(InputErrorOf([&] { (void)DecodeExr(good.substr(0, 40), "c.exr"); }).rfind("c.exr: not a readable OpenEXR file: ", 0),
             0u);
+}
+
+// A data window that does not start at 0,0 (OpenEXR allows any origin) reads back its pixels,
+// without a frame-buffer base pointer outside the buffer (UBSan's pointer overflow, found by the
+// EXR fuzz target; tests/fuzz/regressions/exr/data_window_off_origin.exr).
+TEST(Exr, DataWindowAwayFromTheOriginReadsBack) {
+  const fs::path p = TempDir() / "offset.exr";
+  const Imath::Box2i dw(Imath::V2i(-3, 5), Imath::V2i(0, 6));  // 4 x 2 pixels
+  std::vector<float> px(8);
+  for (size_t i = 0; i < px.size(); ++i) px[i] = 0.5f * static_cast<float>(i);
+  {
+    Imf::Header h(dw, dw);
+    h.channels().insert("x", Imf::Channel(Imf::FLOAT));
+    Imf::OutputFile out(p.c_str(), h, 1);
+    Imf::FrameBuffer fb;
+    fb.insert("x", Imf::Slice::Make(Imf::FLOAT, px.data(), dw, sizeof(float), 4 * sizeof(float)));
+    out.setFrameBuffer(fb);
+    out.writePixels(2);
+  }
+  const ExrImage img = ReadExr(p);
+  EXPECT_EQ(img.width, 4);
+  EXPECT_EQ(img.height, 2);
+  EXPECT_EQ(img.pixels, px);
+  const std::string file = ReadFileBytes(std::filesystem::path(SKYBAKE_SOURCE_DIR) /
+                                         "tests/fuzz/regressions/exr/data_window_off_origin.exr");
+  try {
+    for (const ExrPart& part : DecodeExrParts(file, "crash.exr")) (void)part;
+  } catch (const InputError&) {
+  }
 }
 
 TEST(Exr, MultiPartRoundTrip) {

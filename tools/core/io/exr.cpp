@@ -463,10 +463,11 @@ Imf::FrameBuffer PrepareRead(const Imf::Header& h, ExrImage& img, size_t file_by
   const size_t nch = img.channels.size();
   const size_t xstride = sizeof(float) * nch;
   const size_t ystride = xstride * static_cast<size_t>(img.width);
-  char* base = reinterpret_cast<char*>(img.pixels.data()) -
-               (static_cast<ptrdiff_t>(dw.min.x) * xstride + static_cast<ptrdiff_t>(dw.min.y) * ystride);
+  // Slice::Make places the data window's origin at the first pixel with integer arithmetic: a
+  // base pointer computed as pixels - origin would point outside the buffer (undefined
+  // behaviour for any data window not at 0,0).
   for (size_t c = 0; c < nch; ++c) {
-    fb.insert(img.channels[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xstride, ystride));
+    fb.insert(img.channels[c], Imf::Slice::Make(Imf::FLOAT, img.pixels.data() + c, dw, xstride, ystride));
   }
   return fb;
 }
