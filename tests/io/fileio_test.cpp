@@ -1,6 +1,8 @@
 // Atomic write-if-changed, depfiles and deterministic EXR bytes.
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -95,6 +97,89 @@ TEST(FileIo, RecoveryCompletesDeadJournalsAndRemovesDeadTemporaries) {
   for (auto& e : fs::directory_iterator(d)) names.push_back(e.path().filename().string());
   std::sort(names.begin(), names.end());
   EXPECT_EQ(names, (std::vector<std::string>{"a", "b", live}));
+}
+
+std::vector<std::string> Names(const fs::path& d) {
+  std::vector<std::string> names;
+  for (auto& e : fs::directory_iterator(d)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// A reader honours the journal: reading any file of a folder whose journal a dead run left
+// first completes that run's set (in every folder it spans), so the set is read complete.
+TEST(FileIo, ReadingCompletesADeadRunsCommittedJournal) {
+  const fs::path x = TempDir() / "read-x", y = TempDir() / "read-y";
+  for (const fs::path& d : {x, y}) {
+    fs::remove_all(d);
+    fs::create_directories(d);
+  }
+  const long dead = (1L << 22) + 4322;  // above the default pid_max: no such process
+  const std::string t = ".tmp-" + std::to_string(dead), j = ".skybake-commit-" + std::to_string(dead);
+  // Killed after its commit point: a and b renamed, c still staged; c lies in another folder.
+  WriteFileIfChanged(x / "a", "new a");
+  WriteFileIfChanged(x / "b", "new b");
+  WriteFileIfChanged(y / "c", "old c");
+  WriteFileIfChanged(y / ("c" + t), "new c");
+  const std::string list = (x / "a").string() + "\n" + (x / "b").string() + "\n" + (y / "c").string() + "\n";
+  WriteFileIfChanged(x / j, list);
+  WriteFileIfChanged(y / (j + t), list);  // y's copy was still pending when the run died
+  EXPECT_EQ(ReadFileBytes(y / "c"), "new c");  // y's pending copy leads to x's named one
+  EXPECT_EQ(Names(x), (std::vector<std::string>{"a", "b"}));
+  EXPECT_EQ(Names(y), (std::vector<std::string>{"c"}));
+
+  // Killed before its commit point (no copy has its name): the old set stays for readers, and
+  // the next writer in that folder removes the pending copy and the staged file.
+  WriteFileIfChanged(y / ("c" + t), "newer c");
+  WriteFileIfChanged(y / (j + t), (y / "c").string() + "\n" + (y / "d").string() + "\n");
+  EXPECT_EQ(ReadFileBytes(y / "c"), "new c");
+  EXPECT_EQ(Names(y).size(), 3u);
+  RecoverOutputFolder(y);
+  EXPECT_EQ(Names(y), (std::vector<std::string>{"c"}));
+  EXPECT_EQ(ReadFileBytes(y / "c"), "new c");
+}
+
+// A reader that meets a live commit's journal waits on its lock until the commit has ended, and
+// then reads the new set.
+TEST(FileIo, ReadingWaitsForALiveCommit) {
+  const fs::path d = TempDir() / "read-live";
+  fs::remove_all(d);
+  fs::create_directories(d);
+  const long pid = (1L << 22) + 4323;
+  const std::string t = ".tmp-" + std::to_string(pid);
+  const fs::path journal = d / (".skybake-commit-" + std::to_string(pid));
+  WriteFileIfChanged(d / "a", "new a");
+  WriteFileIfChanged(d / "b", "old b");
+  WriteFileIfChanged(d / ("b" + t), "new b");
+  WriteFileIfChanged(journal, (d / "a").string() + "\n" + (d / "b").string() + "\n");
+  const int fd = ::open(journal.c_str(), O_RDONLY);
+  ASSERT_GE(fd, 0);
+  ASSERT_EQ(::flock(fd, LOCK_EX), 0);  // the writer's lock (another open file description)
+  std::thread writer([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    fs::rename(d / ("b" + t), d / "b");
+    fs::remove(journal);
+    ::close(fd);
+  });
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_EQ(ReadFileBytes(d / "a"), "new a");
+  EXPECT_EQ(ReadFileBytes(d / "b"), "new b");
+  EXPECT_GE(std::chrono::steady_clock::now() - t0, std::chrono::milliseconds(250));
+  writer.join();
+  EXPECT_EQ(Names(d), (std::vector<std::string>{"a", "b"}));
+}
+
+// A commit across two folders leaves no journal and no temporary file in either.
+TEST(FileIo, CommitAcrossFoldersLeavesNoJournal) {
+  const fs::path x = TempDir() / "tx-x", y = TempDir() / "tx-y";
+  for (const fs::path& d : {x, y}) fs::remove_all(d);
+  BeginOutputTransaction();
+  EXPECT_TRUE(WriteFileIfChanged(x / "a", "a"));
+  EXPECT_TRUE(WriteFileIfChanged(y / "b", "b"));
+  EXPECT_EQ(CommitOutputTransaction(), 2u);
+  AbortOutputTransaction();
+  EXPECT_EQ(Names(x), (std::vector<std::string>{"a"}));
+  EXPECT_EQ(Names(y), (std::vector<std::string>{"b"}));
 }
 
 TEST(FileIo, Depfile) {
