@@ -219,7 +219,11 @@ PointsResult EvaluatePoints(const Scene& scene, const PointsOptions& o, const Po
   for (size_t r = 0; r < in.rows.size(); ++r) by_altitude[in.rows[r].observer_altitude_m].push_back(r);
   const size_t nw = scene.model.wavelengths();
   res.has_single = true;
-  for (const auto& [alt, rows] : by_altitude) {
+  for (const auto& group : by_altitude) {
+    // Named copies, not structured bindings: the lambda below captures them (clang 14, the
+    // sanitizer build's compiler, does not capture structured bindings).
+    const double alt = group.first;
+    const std::vector<size_t>& rows = group.second;
     SkyMethodOptions mo = o.method_options;
     mo.observer_altitude_m = alt;
     std::unique_ptr<SkyMethod> method = MakeSkyMethod(o.method, scene.model, mo, progress);
