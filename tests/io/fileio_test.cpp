@@ -1,4 +1,5 @@
 // Atomic write-if-changed, depfiles and deterministic EXR bytes.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <fcntl.h>
@@ -335,6 +336,19 @@ TEST(Exr, HeaderFieldsTheFileCannotHoldAreRefusedBeforeDecoding) {
   StoreI32(tall, AttributeSizeAt(tall, "dataWindow", "box2i") + 4 + 12, 9999999);
   EXPECT_NE(InputErrorOf([&] { (void)DecodeExr(tall, "t.exr"); }).find("t.exr: not a readable OpenEXR file: "),
             std::string::npos);
+
+  // 100 x 100 values need 20 000 bytes uncompressed (NONE, ratio 1); the file has a few hundred.
+  // The same window with ZIP (ratio up to 1032) passes this check and fails on its missing data.
+  std::string wide = good;
+  StoreI32(wide, AttributeSizeAt(wide, "dataWindow", "box2i") + 4 + 8, 99);
+  StoreI32(wide, AttributeSizeAt(wide, "dataWindow", "box2i") + 4 + 12, 99);
+  std::string wide_none = wide;
+  wide_none[AttributeSizeAt(wide_none, "compression", "compression") + 4] = 0;
+  EXPECT_EQ(InputErrorOf([&] { (void)DecodeExr(wide_none, "w.exr"); }),
+            fmt::format("w.exr: not a readable OpenEXR file: a data window of 100 x 100 with 1 channels is more than "
+                        "{} bytes can hold",
+                        wide.size()));
+  EXPECT_EQ(InputErrorOf([&] { (void)DecodeExr(wide, "w.exr"); }).find("can hold"), std::string::npos);
 
   std::vector<ExrPart> parts = {{"first", img}, {"second", img}};
   std::string many = EncodeExrParts(parts);  // a part claiming 10^8 chunks

@@ -246,14 +246,14 @@ ExrTable ImageToTable(const ExrImage& img, const std::string& name) {
 //  - the parts' chunks (the `chunkCount` attribute, or the data window's scanline blocks of
 //    the compression's height, or its level-0 tiles) need their 8-byte offsets in the rest of
 //    the file;
-//  - the data window times the channel count obeys PrepareRead's bound (4096 pixel values per
-//    byte of file: more than any OpenEXR compression of real data reaches).
+//  - the data window times the channel count, at 2 bytes per value, is at most the largest
+//    ratio of the part's compression times the file's bytes (MaxCompressionRatio).
 namespace {
 
 struct ExrPartLayout {
   bool has_window = false, has_tiles = false;
   int64_t w = 0, h = 0, channels = 0, chunk_count = -1;
-  int compression = 0;  // Imf::Compression: 0 none, 1 RLE, 2 ZIPS, 3 ZIP, 4 PIZ, 5 PXR24, 6 B44, 7 B44A, 8 DWAA, 9 DWAB
+  int compression = -1;  // none given; Imf::Compression: 0 none, 1 RLE, 2 ZIPS, 3 ZIP, 4 PIZ, 5 PXR24, 6 B44, 7 B44A, 8 DWAA, 9 DWAB
   uint32_t tile_x = 0, tile_y = 0;
 };
 
@@ -308,6 +308,22 @@ void CheckAttributeSize(const std::string& attr, const std::string& type, const 
     if (w * h * 4 + 8 != static_cast<uint64_t>(size)) bad(fmt::format("of {} x {} pixels has {} bytes", w, h, size));
   } else if (type == "floatvector") {
     if (size % 4 != 0) bad(fmt::format("has {} bytes, not a multiple of 4", size));
+  }
+}
+
+// The largest ratio of pixel bytes to compressed bytes each compression can reach: NONE 1;
+// RLE 64 (a 2-byte run of up to 128 bytes); ZIPS, ZIP 1032 (deflate's limit, RFC 1951: a
+// 258-byte match in 2 bits at best, Adler's zlib FAQ); PXR24 1376 (deflate of 3 bytes per 4-byte
+// float); B44, B44A 11 (a flat 4x4 block of half, 32 bytes, in 3); PIZ, DWAA, DWAB (run-length
+// Huffman and deflate stages without a simple limit) 8192, the bound PrepareRead uses for all.
+double MaxCompressionRatio(int compression) {
+  switch (compression) {
+    case 0: return 1.0;
+    case 1: return 64.0;
+    case 2: case 3: return 1032.0;
+    case 5: return 1376.0;
+    case 6: case 7: return 11.0;
+    default: return 8192.0;
   }
 }
 
@@ -379,9 +395,11 @@ void CheckExrLayout(const std::string& bytes, const std::string& name) {
   uint64_t chunks = 0;
   for (const ExrPartLayout& p : parts) {
     if (!p.has_window) continue;  // OpenEXR refuses a header without its data window
-    if (p.w < 1 || p.h < 1 ||
-        static_cast<double>(p.w) * static_cast<double>(p.h) * static_cast<double>(std::max<int64_t>(p.channels, 1)) >
-            4096.0 * static_cast<double>(n)) {
+    // At 2 bytes per value (half, the smallest), the pixels are at most the compression's
+    // largest ratio times the file's bytes.
+    const double values =
+        static_cast<double>(p.w) * static_cast<double>(p.h) * static_cast<double>(std::max<int64_t>(p.channels, 1));
+    if (p.w < 1 || p.h < 1 || 2.0 * values > MaxCompressionRatio(p.compression) * static_cast<double>(n)) {
       refuse(fmt::format("a data window of {} x {} with {} channels is more than {} bytes can hold", p.w, p.h,
                          p.channels, n));
     }
