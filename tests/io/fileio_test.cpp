@@ -390,6 +390,15 @@ TEST(Exr, DataWindowAwayFromTheOriginReadsBack) {
   }
 }
 
+// A chunk whose size field makes OpenEXR ask the input stream for a negative number of bytes
+// is a bad file (UBSan's pointer overflow in the stream, found by the EXR fuzz target).
+TEST(Exr, NegativeReadSizeIsAnInputError) {
+  const std::string file = ReadFileBytes(std::filesystem::path(SKYBAKE_SOURCE_DIR) /
+                                         "tests/fuzz/regressions/exr/negative_read_size.exr");
+  EXPECT_NE(InputErrorOf([&] { (void)DecodeExrParts(file, "n.exr"); }).find("n.exr: not a readable OpenEXR file"),
+            std::string::npos);
+}
+
 TEST(Exr, MultiPartRoundTrip) {
   ExrImage a, b;
   a.Resize(3, 2, {"x"});

@@ -60,7 +60,9 @@ class MemIStream : public Imf::IStream {
  public:
   MemIStream(const std::string& data, const std::string& name) : Imf::IStream(name.c_str()), data_(data) {}
   bool read(char c[], int n) override {
-    if (pos_ + static_cast<size_t>(n) > data_.size()) {
+    // OpenEXR passes sizes it read from the file: a negative one, or one past the end (also
+    // after a seek beyond it), is a corrupt file.
+    if (n < 0 || pos_ > data_.size() || static_cast<size_t>(n) > data_.size() - pos_) {
       throw Iex::InputExc("Unexpected end of file.");
     }
     std::memcpy(c, data_.data() + pos_, static_cast<size_t>(n));
