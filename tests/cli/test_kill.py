@@ -107,7 +107,9 @@ class KillTest(TempDirTestCase):
             self.read_as_a_skybake_tool(OUTPUTS[i % len(OUTPUTS)])
             seen = self.snapshot()
             self.assertIn(seen, (set_a, set_b), "a reader saw a mixed set after a kill at %.3f s" % delay)
-            self.assertEqual(self.journals(), [])
+            # No committed journal is left; a kill before the commit point may leave a pending
+            # one, which the next run removes with the staged files.
+            self.assertEqual([j for j in self.journals() if ".tmp-" not in j], [])
             if now != set_a:
                 self.assertEqual(seen, set_b)  # a committed journal completes to the new set
             read["old set" if seen == set_a else "new set"] += 1
