@@ -60,6 +60,9 @@ int main(int argc, char** argv) {
     cli.Info(std::string(r.changed ? "wrote " : "unchanged ") + r.build_ninja.string());
     if (!bake->parsed()) return;
     CommitOutputTransaction();  // ninja reads build.ninja and the components from disk
+    // A tool killed after its commit point left a journal; complete every one under the outputs
+    // folder, so that ninja (which reads the products' mtimes and depfiles) sees complete sets.
+    RecoverOutputTree(r.build_ninja.parent_path());
     std::vector<std::string> args = {"ninja", "-C", r.build_ninja.parent_path().string()};
     if (jobs > 0) args.push_back("-j" + std::to_string(jobs));
     args.insert(args.end(), ninja_args.begin(), ninja_args.end());

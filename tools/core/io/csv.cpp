@@ -1,4 +1,5 @@
 #include "io/csv.h"
+#include "io/fileio.h"
 
 #include <charconv>
 #include <cmath>
@@ -99,11 +100,7 @@ std::string UnitSuffixes(Quantity q) {
 }
 
 CsvTable CsvTable::Load(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(FileLoc{path.string(), 0}, "cannot open file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return Parse(ss.str(), path.string());
+  return Parse(ReadFileBytes(path), path.string());
 }
 
 CsvTable CsvTable::Parse(const std::string& text, const std::string& display_name) {

@@ -19,7 +19,10 @@
 #include <ImfStringAttribute.h>
 #include <Iex.h>
 
+#include <charconv>
+#include <cmath>
 #include <cstring>
+#include <map>
 
 #include <fmt/format.h>
 
@@ -57,7 +60,9 @@ class MemIStream : public Imf::IStream {
  public:
   MemIStream(const std::string& data, const std::string& name) : Imf::IStream(name.c_str()), data_(data) {}
   bool read(char c[], int n) override {
-    if (pos_ + static_cast<size_t>(n) > data_.size()) {
+    // OpenEXR passes sizes it read from the file: a negative one, or one past the end (also
+    // after a seek beyond it), is a corrupt file.
+    if (n < 0 || pos_ > data_.size() || static_cast<size_t>(n) > data_.size() - pos_) {
       throw Iex::InputExc("Unexpected end of file.");
     }
     std::memcpy(c, data_.data() + pos_, static_cast<size_t>(n));
@@ -203,7 +208,14 @@ ExrTable ImageToTable(const ExrImage& img, const std::string& name) {
     while (pos < vals.size()) {
       size_t end = vals.find(' ', pos);
       if (end == std::string::npos) end = vals.size();
-      a.values.push_back(std::stod(vals.substr(pos, end - pos)));
+      // Each value is a whole finite number (the writer's {:.17g}); anything else is a bad file.
+      const std::string tok = vals.substr(pos, end - pos);
+      double v = 0.0;
+      const auto res = std::from_chars(tok.data(), tok.data() + tok.size(), v, std::chars_format::general);
+      if (tok.empty() || res.ec != std::errc() || res.ptr != tok.data() + tok.size() || !std::isfinite(v)) {
+        fail(fmt::format("attribute {}values: '{}' is not a finite number", pre, tok));
+      }
+      a.values.push_back(v);
       pos = end + 1;
     }
     count *= a.values.size();
@@ -223,6 +235,193 @@ ExrTable ImageToTable(const ExrImage& img, const std::string& name) {
 }
 
 // ---------------------------------------------------------------------------- encode / decode
+
+// The layout of an OpenEXR file's headers (OpenEXR "File Layout": the magic number 20000630,
+// a version field with flags 0x200 single-part tiled, 0x400 long names, 0x800 deep, 0x1000
+// multi-part; then each header as attributes `name\0 type\0 int32 size, size bytes`, ended by
+// an empty name; a multi-part file's list of headers ends with an empty header; then every
+// part's chunk offset table, 8 bytes per chunk). OpenEXR allocates an attribute's value, a
+// part's offset table and its line buffers from these fields before it finds that the file
+// cannot hold them: a 1 KB input could make it allocate gigabytes. This walk refuses such a
+// file first, with the cost of reading the headers only.
+//  - every attribute's size must be >= 0 and fit in the bytes that follow it;
+//  - the parts' chunks (the `chunkCount` attribute, or the data window's scanline blocks of
+//    the compression's height, or its level-0 tiles) need their 8-byte offsets in the rest of
+//    the file;
+//  - the data window times the channel count, at 2 bytes per value, is at most the largest
+//    ratio of the part's compression times the file's bytes (MaxCompressionRatio).
+namespace {
+
+struct ExrPartLayout {
+  bool has_window = false, has_tiles = false;
+  int64_t w = 0, h = 0, channels = 0, chunk_count = -1;
+  int compression = -1;  // none given; Imf::Compression: 0 none, 1 RLE, 2 ZIPS, 3 ZIP, 4 PIZ, 5 PXR24, 6 B44, 7 B44A, 8 DWAA, 9 DWAB
+  uint32_t tile_x = 0, tile_y = 0;
+};
+
+int32_t LoadI32(const char* p) {
+  uint32_t v = 0;
+  for (int i = 3; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(p[i]);
+  return static_cast<int32_t>(v);
+}
+
+// Scanlines per chunk of each compression (OpenEXR "Compression methods").
+int64_t LinesPerChunk(int compression) {
+  switch (compression) {
+    case 3: case 5: return 16;            // ZIP, PXR24
+    case 4: case 6: case 7: case 8: return 32;  // PIZ, B44, B44A, DWAA
+    case 9: return 256;                   // DWAB
+    default: return 1;                    // NONE, RLE, ZIPS (an unknown one OpenEXR refuses)
+  }
+}
+
+// OpenEXR reads a value of a fixed-size type by its type, whatever size the file declares, and
+// a channel list or a preview by its own fields: a declared size that disagrees would make it
+// read the following bytes as a different chain of attributes than the one checked here.
+template <typename Refuse>
+void CheckAttributeSize(const std::string& attr, const std::string& type, const char* v, int64_t size,
+                        const Refuse& refuse) {
+  static const std::map<std::string, int64_t> kFixed = {
+      {"box2i", 16},  {"box2f", 16},  {"int", 4},        {"float", 4},     {"double", 8},
+      {"compression", 1}, {"lineOrder", 1}, {"envmap", 1}, {"deepImageState", 1},
+      {"v2i", 8},     {"v2f", 8},     {"v2d", 16},       {"v3i", 12},      {"v3f", 12},
+      {"v3d", 24},    {"m33f", 36},   {"m33d", 72},      {"m44f", 64},     {"m44d", 128},
+      {"tiledesc", 9}, {"chromaticities", 32}, {"rational", 8}, {"timecode", 8}, {"keycode", 28}};
+  auto bad = [&](const std::string& why) {
+    refuse(fmt::format("attribute '{}' of type {} {}", attr, type, why));
+  };
+  if (auto it = kFixed.find(type); it != kFixed.end()) {
+    if (size != it->second) bad(fmt::format("has {} bytes, not {}", size, it->second));
+  } else if (type == "chlist") {
+    // Channels: name\0 then 16 bytes each, ended by an empty name, all inside the value.
+    int64_t c = 0;
+    while (true) {
+      if (c >= size) bad("has no end");
+      if (v[c] == '\0') break;
+      const void* z = std::memchr(v + c, '\0', static_cast<size_t>(size - c));
+      if (!z) bad("has a channel name without an end");
+      c = (static_cast<const char*>(z) - v) + 1 + 16;
+    }
+    if (c + 1 != size) bad(fmt::format("ends at byte {} of {}", c + 1, size));
+  } else if (type == "preview") {
+    // Width and height (uint32), then 4 bytes per pixel.
+    if (size < 8) bad("has no dimensions");
+    const uint64_t w = static_cast<uint32_t>(LoadI32(v)), h = static_cast<uint32_t>(LoadI32(v + 4));
+    if (w * h * 4 + 8 != static_cast<uint64_t>(size)) bad(fmt::format("of {} x {} pixels has {} bytes", w, h, size));
+  } else if (type == "floatvector") {
+    if (size % 4 != 0) bad(fmt::format("has {} bytes, not a multiple of 4", size));
+  }
+}
+
+// The largest ratio of pixel bytes to compressed bytes each compression can reach: NONE 1;
+// RLE 64 (a 2-byte run of up to 128 bytes); ZIPS, ZIP 1032 (deflate's limit, RFC 1951: a
+// 258-byte match in 2 bits at best, Adler's zlib FAQ); PXR24 1376 (deflate of 3 bytes per 4-byte
+// float); B44, B44A 11 (a flat 4x4 block of half, 32 bytes, in 3); PIZ, DWAA, DWAB (run-length
+// Huffman and deflate stages without a simple limit) 8192, the bound PrepareRead uses for all.
+double MaxCompressionRatio(int compression) {
+  switch (compression) {
+    case 0: return 1.0;
+    case 1: return 64.0;
+    case 2: case 3: return 1032.0;
+    case 5: return 1376.0;
+    case 6: case 7: return 11.0;
+    default: return 8192.0;
+  }
+}
+
+void CheckExrLayout(const std::string& bytes, const std::string& name) {
+  auto refuse = [&](const std::string& why) {
+    throw InputError(FileLoc{name, 0}, "not a readable OpenEXR file: " + why);
+  };
+  const size_t n = bytes.size();
+  if (n < 8 || LoadI32(bytes.data()) != 20000630) refuse("no OpenEXR magic number");
+  const int32_t version = LoadI32(bytes.data() + 4);
+  const bool multipart = (version & 0x1000) != 0, single_tiled = (version & 0x200) != 0;
+  const size_t max_name = (version & 0x400) ? 255 : 31;
+  size_t pos = 8;
+  auto read_string = [&](const char* what) {
+    const size_t end = bytes.find('\0', pos);
+    if (end == std::string::npos || end - pos > max_name) refuse(fmt::format("the {} at byte {} has no end", what, pos));
+    std::string s = bytes.substr(pos, end - pos);
+    pos = end + 1;
+    return s;
+  };
+  std::vector<ExrPartLayout> parts;
+  while (true) {
+    if (pos >= n) refuse("the headers end before the file's data");
+    if (multipart && !parts.empty() && bytes[pos] == '\0') {  // the empty header ending the list
+      ++pos;
+      break;
+    }
+    ExrPartLayout part;
+    part.has_tiles = single_tiled;
+    while (true) {
+      if (pos >= n) refuse("a header has no end");
+      if (bytes[pos] == '\0') {
+        ++pos;
+        break;
+      }
+      const std::string attr = read_string("attribute name");
+      const std::string type = read_string("attribute type");
+      if (n - pos < 4) refuse(fmt::format("attribute '{}' has no size", attr));
+      const int64_t size = LoadI32(bytes.data() + pos);
+      pos += 4;
+      if (size < 0 || static_cast<uint64_t>(size) > n - pos) {
+        refuse(fmt::format("attribute '{}' claims {} bytes, {} are left", attr, size, n - pos));
+      }
+      const char* v = bytes.data() + pos;
+      CheckAttributeSize(attr, type, v, size, refuse);
+      if (attr == "dataWindow" && type == "box2i" && size == 16) {
+        part.has_window = true;
+        part.w = int64_t{LoadI32(v + 8)} - LoadI32(v) + 1;
+        part.h = int64_t{LoadI32(v + 12)} - LoadI32(v + 4) + 1;
+      } else if (attr == "compression" && type == "compression" && size == 1) {
+        part.compression = static_cast<unsigned char>(v[0]);
+      } else if (attr == "chunkCount" && type == "int" && size == 4) {
+        part.chunk_count = LoadI32(v);
+      } else if (attr == "tiles" && type == "tiledesc" && size == 9) {
+        part.tile_x = static_cast<uint32_t>(LoadI32(v));
+        part.tile_y = static_cast<uint32_t>(LoadI32(v + 4));
+      } else if (attr == "type" && type == "string") {
+        const std::string t(v, static_cast<size_t>(size));
+        part.has_tiles = t == "tiledimage" || t == "deeptile";
+      } else if (attr == "channels" && type == "chlist") {
+        // name\0 then 16 bytes (pixel type, pLinear, reserved, x and y sampling) per channel.
+        for (size_t c = 0; v[c] != '\0'; ++part.channels) c = std::strlen(v + c) + c + 1 + 16;
+      }
+      pos += static_cast<size_t>(size);
+    }
+    parts.push_back(part);
+    if (!multipart) break;
+  }
+  uint64_t chunks = 0;
+  for (const ExrPartLayout& p : parts) {
+    if (!p.has_window) continue;  // OpenEXR refuses a header without its data window
+    // At 2 bytes per value (half, the smallest), the pixels are at most the compression's
+    // largest ratio times the file's bytes.
+    const double values =
+        static_cast<double>(p.w) * static_cast<double>(p.h) * static_cast<double>(std::max<int64_t>(p.channels, 1));
+    if (p.w < 1 || p.h < 1 || 2.0 * values > MaxCompressionRatio(p.compression) * static_cast<double>(n)) {
+      refuse(fmt::format("a data window of {} x {} with {} channels is more than {} bytes can hold", p.w, p.h,
+                         p.channels, n));
+    }
+    uint64_t c = 0;
+    if (p.chunk_count >= 0) {
+      c = static_cast<uint64_t>(p.chunk_count);
+    } else if (p.has_tiles && p.tile_x > 0 && p.tile_y > 0) {
+      c = static_cast<uint64_t>((p.w + p.tile_x - 1) / p.tile_x) * static_cast<uint64_t>((p.h + p.tile_y - 1) / p.tile_y);
+    } else if (!p.has_tiles) {
+      const int64_t lines = LinesPerChunk(p.compression);
+      c = static_cast<uint64_t>((p.h + lines - 1) / lines);
+    }
+    chunks += c;
+    if (chunks > (n - pos) / 8) {
+      refuse(fmt::format("{} chunks need {} bytes of offsets, {} are left", chunks, 8 * chunks, n - pos));
+    }
+  }
+}
+
+}  // namespace
 
 namespace {
 
@@ -284,10 +483,11 @@ Imf::FrameBuffer PrepareRead(const Imf::Header& h, ExrImage& img, size_t file_by
   const size_t nch = img.channels.size();
   const size_t xstride = sizeof(float) * nch;
   const size_t ystride = xstride * static_cast<size_t>(img.width);
-  char* base = reinterpret_cast<char*>(img.pixels.data()) -
-               (static_cast<ptrdiff_t>(dw.min.x) * xstride + static_cast<ptrdiff_t>(dw.min.y) * ystride);
+  // Slice::Make places the data window's origin at the first pixel with integer arithmetic: a
+  // base pointer computed as pixels - origin would point outside the buffer (undefined
+  // behaviour for any data window not at 0,0).
   for (size_t c = 0; c < nch; ++c) {
-    fb.insert(img.channels[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xstride, ystride));
+    fb.insert(img.channels[c], Imf::Slice::Make(Imf::FLOAT, img.pixels.data() + c, dw, xstride, ystride));
   }
   return fb;
 }
@@ -312,6 +512,7 @@ bool WriteExr(const std::filesystem::path& path, const ExrImage& image) {
 
 ExrImage DecodeExr(const std::string& bytes, const std::string& name) {
   ExrImage img;
+  CheckExrLayout(bytes, name);
   try {
     MemIStream is(bytes, name);
     Imf::InputFile in(is, 1);
@@ -358,6 +559,7 @@ bool WriteExrParts(const std::filesystem::path& path, const std::vector<ExrPart>
 
 std::vector<ExrPart> DecodeExrParts(const std::string& bytes, const std::string& name) {
   std::vector<ExrPart> parts;
+  CheckExrLayout(bytes, name);
   try {
     MemIStream is(bytes, name);
     Imf::MultiPartInputFile in(is, 1);

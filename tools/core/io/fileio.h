@@ -4,16 +4,25 @@
 //    (fsync) and renamed over the target. A crash or SIGKILL at any moment leaves either the old
 //    file or the new one, never a partial file; an unchanged file keeps its mtime, so Ninja's
 //    `restat = 1` prunes everything downstream.
-//  - One transaction per command: between BeginOutputTransaction() and CommitOutputTransaction()
-//    (io/cli.h's ToolCli::Run opens one around every tool's body) WriteFileIfChanged only
-//    *stages* a changed file as `<target>.tmp-<pid>` (written and flushed); the commit first
-//    writes a journal `.skybake-commit-<pid>` beside the first staged file listing every target,
-//    then renames each staged file over its target, then removes the journal. A command that
-//    fails (AbortOutputTransaction) removes its staged files and leaves every old output as it
-//    was. A run killed while staging leaves only temporary files; one killed during the renames
-//    leaves its journal. The next transaction that writes into that folder completes a dead
-//    run's journal (renames the staged files it lists that are still there), so the folder holds
-//    the complete new set, and removes every other `*.tmp-<pid>` whose process is gone.
+//  - One transaction per command (docs/pipeline.md, "One transaction per command", states
+//    what a reader may observe): between BeginOutputTransaction() and CommitOutputTransaction() (io/cli.h's
+//    ToolCli::Run opens one around every tool's body) WriteFileIfChanged only *stages* a
+//    changed file as `<target>.tmp-<pid>` (written and flushed). A commit of more than one file
+//    writes a journal listing every target into every folder of the set: first as a pending
+//    copy `.skybake-commit-<pid>.tmp-<pid>` (locked with flock, written, flushed) in each
+//    folder, then each is renamed to `.skybake-commit-<pid>` - the first of these renames is
+//    the commit point - then the folders are flushed, then every staged file is renamed over
+//    its target with no other I/O between the renames, then the folders are flushed and the
+//    journals removed; the lock is held until then. A command that fails
+//    (AbortOutputTransaction) removes its staged files and leaves every old output as it was.
+//  - Readers honour the journal: ReadFileBytes (which every loader of the core uses) first
+//    completes any committed journal in the folder of the file it reads
+//    (CompleteCommittedJournals): it waits on a live commit's lock, and rolls a dead run's journal forward. So a skybake tool
+//    never reads a mixed set. A run killed while staging leaves only temporary files; one
+//    killed after the commit point leaves its journal until the next reader or writer of that
+//    folder (or `skybake bake`, which recovers the whole outputs tree before it runs ninja)
+//    completes it. Every transaction that writes into a folder also removes the temporary
+//    files of dead runs that no journal protects.
 //  - Depfiles in Make syntax listing the inputs a tool read (`deps = gcc`).
 //  - Content hashes for provenance (xxHash XXH3-64, hex).
 #pragma once
@@ -26,7 +35,9 @@
 
 namespace skybake {
 
-// Reads a whole file; throws InputError(path) if it cannot be read.
+// Reads a whole file, after completing the committed journals of its folder (so a set of
+// outputs is read complete: the old set or the new one); throws InputError(path) if it cannot
+// be read.
 std::string ReadFileBytes(const std::filesystem::path& path);
 
 // Writes `bytes` to `path` atomically unless the file already holds exactly these bytes.
@@ -43,9 +54,16 @@ void BeginOutputTransaction();
 size_t CommitOutputTransaction();
 // Removes the staged files and closes the transaction; the old outputs stay untouched.
 void AbortOutputTransaction();
-// Completes a dead run's journal and removes stale `*.tmp-<pid>` files (pid not running) in
-// `dir`. Called for the folder of every file staged; exposed for tests.
+// Completes the committed journals in `dir`: waits for a live commit to end, rolls a dead
+// run's forward. Called by ReadFileBytes for the folder of every file it reads.
+void CompleteCommittedJournals(const std::filesystem::path& dir);
+// Completes the journals in `dir` and removes the temporary files of dead runs (pid not
+// running) that no journal protects, and their uncommitted pending journals. Called for the
+// folder of every file staged; exposed for tests.
 void RecoverOutputFolder(const std::filesystem::path& dir);
+// RecoverOutputFolder for `root` and every folder below it, all journals first (skybake bake
+// calls it for the outputs folder before it runs ninja).
+void RecoverOutputTree(const std::filesystem::path& root);
 
 // Make-syntax depfile "target: in1 in2 ...", written with WriteFileIfChanged.
 void WriteDepfile(const std::filesystem::path& depfile, const std::filesystem::path& target,

@@ -1,4 +1,5 @@
 #include "io/yaml.h"
+#include "io/fileio.h"
 
 #include <algorithm>
 #include <charconv>
@@ -533,13 +534,10 @@ void YamlMap::Finish() {
 // ---------------------------------------------------------------------------- YamlDocument
 
 YamlDocument YamlDocument::Load(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(FileLoc{path.string(), 0}, "cannot open file");
-  std::stringstream ss;
-  ss << in.rdbuf();
+  const std::string text = ReadFileBytes(path);
   std::filesystem::path dir = path.parent_path();
   if (dir.empty()) dir = ".";
-  return Parse(ss.str(), path.string(), dir);
+  return Parse(text, path.string(), dir);
 }
 
 YamlDocument YamlDocument::Parse(const std::string& text, const std::string& display_name,

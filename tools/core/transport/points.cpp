@@ -145,14 +145,13 @@ uint64_t PointStreamKey(const PointGeometry& g) {
 
 double SpectralErrorFloor(double y_floor_cd_m2) { return y_floor_cd_m2 / (683.0 * 106.857); }
 
-PointsInput LoadPointsInput(const Scene& scene, const PointsOptions& o) {
+PointsInput ParsePointGeometries(const CsvTable& csv, double default_altitude_m, double top_m) {
   PointsInput in;
-  CsvTable csv = CsvTable::Load(o.geometry);
   Diagnostics d;
   std::vector<double> sza = csv.Numbers("sun_zenith_deg", d);
   std::vector<double> vza = csv.Numbers("view_zenith_deg", d);
   std::vector<double> raz = csv.Numbers("relative_azimuth_deg", d);
-  std::vector<double> alt(csv.rows(), scene.spec.observer_altitude_m);
+  std::vector<double> alt(csv.rows(), default_altitude_m);
   for (const std::string& c : csv.columns()) {
     if (c.rfind("observer_altitude_", 0) == 0) in.altitude_column = c;
   }
@@ -161,7 +160,6 @@ PointsInput LoadPointsInput(const Scene& scene, const PointsOptions& o) {
     if (a) alt = a->values;
   }
   d.ThrowIfAny();
-  const double top_m = scene.model.altitude_m.back();
   for (size_t r = 0; r < csv.rows(); ++r) {
     if (!(sza[r] >= 0 && sza[r] <= 180)) d.Add(csv.LocOfRow(r), "sun_zenith_deg must be in 0-180");
     if (!(vza[r] >= 0 && vza[r] <= 180)) d.Add(csv.LocOfRow(r), "view_zenith_deg must be in 0-180");
@@ -174,6 +172,12 @@ PointsInput LoadPointsInput(const Scene& scene, const PointsOptions& o) {
     in.rows.push_back({sza[r], vza[r], raz[r], alt[r]});
   }
   d.ThrowIfAny();
+  return in;
+}
+
+PointsInput LoadPointsInput(const Scene& scene, const PointsOptions& o) {
+  PointsInput in = ParsePointGeometries(CsvTable::Load(o.geometry), scene.spec.observer_altitude_m,
+                                        scene.model.altitude_m.back());
   if (o.wavelengths_nm.empty()) throw UsageError("--wavelengths-out: expected at least one wavelength");
   if (o.wavelengths_nm.size() > static_cast<size_t>(PathTracer::kMaxWavelengths)) {
     throw UsageError(fmt::format("--wavelengths-out: at most {} wavelengths, got {}", PathTracer::kMaxWavelengths,
@@ -216,7 +220,11 @@ PointsResult EvaluatePoints(const Scene& scene, const PointsOptions& o, const Po
   for (size_t r = 0; r < in.rows.size(); ++r) by_altitude[in.rows[r].observer_altitude_m].push_back(r);
   const size_t nw = scene.model.wavelengths();
   res.has_single = true;
-  for (const auto& [alt, rows] : by_altitude) {
+  for (const auto& group : by_altitude) {
+    // Named copies, not structured bindings: the lambda below captures them (clang 14, the
+    // sanitizer build's compiler, does not capture structured bindings).
+    const double alt = group.first;
+    const std::vector<size_t>& rows = group.second;
     SkyMethodOptions mo = o.method_options;
     mo.observer_altitude_m = alt;
     std::unique_ptr<SkyMethod> method = MakeSkyMethod(o.method, scene.model, mo, progress);

@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "io/csv.h"
 #include "io/progress.h"
 #include "transport/sky_method.h"
 #include "transport/sky_scene.h"
@@ -51,6 +52,11 @@ struct PointsInput {
   std::string altitude_column;  // the CSV's observer altitude column ("" = none: the atmosphere's)
   std::vector<size_t> wavelengths;  // grid indices of --wavelengths-out
 };
+
+// Validates the geometry CSV's rows (sun and view zenith in 0-180 deg, relative azimuth in
+// -360-360 deg, the observer altitude column, if any, in [0, top_m)); rows without an altitude
+// column get `default_altitude_m`. InputError file:line for a bad row; `wavelengths` stays empty.
+PointsInput ParsePointGeometries(const CsvTable& csv, double default_altitude_m, double top_m);
 
 // Reads and validates the geometry CSV and the output wavelengths (InputError file:line for a
 // bad row, UsageError for a wavelength off the grid), before any work.
