@@ -63,11 +63,7 @@ void FirstOrder(const AtmosphereModel& m, const Medium& md, const SunTables& sun
             tc->sun_az[nodes.Cell(ri, si, k, q) * nt + st] = StepSunAzimuth(nodes, tc->s->azimuth_even, f, st, r, ts, nu_s);
           }
         }
-        if (f.ground) {
-          const double mus_g = (r * std::cos(ts) + f.d * nu_s) / R;
-          InterpE(nodes, E0, std::acos(std::clamp(mus_g, -1.0, 1.0)), eg.data());
-          for (size_t w = 0; w < nw; ++w) acc[w] += f.trans_end[w] * static_cast<float>(md.albedo[w] / kPi) * eg[w];
-        }
+        if (f.ground) AddGroundReflection(nodes, md, f, r, ts, nu_s, E0, eg.data(), acc.data());
         std::copy(acc.begin(), acc.end(), &(*L)[nodes.Cell(ri, si, k, q) * nw]);
       }
     }

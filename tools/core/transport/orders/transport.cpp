@@ -89,6 +89,13 @@ std::vector<float> LogLinFactors(const TransportContext& tc, const Table& Jin) {
   return cfac;
 }
 
+void AddGroundReflection(const Nodes& nodes, const Medium& md, const Family& f, double r, double ts, double nu,
+                         const std::vector<float>& E, float* eg, float* acc) {
+  const double mus_g = (r * std::cos(ts) + f.d * nu) / nodes.bottom_radius_m;
+  InterpE(nodes, E, std::acos(std::clamp(mus_g, -1.0, 1.0)), eg);
+  for (size_t w = 0; w < md.nw; ++w) acc[w] += f.trans_end[w] * static_cast<float>(md.albedo[w] / kPi) * eg[w];
+}
+
 void LogBlend(const TransportContext& tc, const std::vector<float>& cfac, const SunAzimuth& p, size_t r0, float* jlo, const float* jhi) {
   const size_t nw = tc.md->nw, ns = tc.nodes->ns, nr = tc.nodes->radius.size();
   const float fb = p.ts * kLogBins;
@@ -108,8 +115,6 @@ void LogBlend(const TransportContext& tc, const std::vector<float>& cfac, const 
 void TransportCells(const TransportContext& tc, const Table& Jin, const Table& Lin, Table* Lout) {
   const Nodes& nodes = *tc.nodes;
   const size_t nw = tc.md->nw, ns = nodes.ns, nu = nodes.nu, nphi = static_cast<size_t>(nodes.nphi), nr = nodes.radius.size();
-  const double R = nodes.bottom_radius_m;
-  const std::vector<double>& albedo = tc.md->albedo;
   std::vector<float> E;
   GroundIrradiance(nodes, tc.s->ndn, Lin, &E);
   const std::vector<float> cfac = LogLinFactors(tc, Jin);
@@ -127,11 +132,9 @@ void TransportCells(const TransportContext& tc, const Table& Jin, const Table& L
           const SunAzimuth p = tc.StepPosition(f, m, ri, si, k, q);
           if (p.si == kNoSun) continue;
           const size_t so = (static_cast<size_t>(p.si) * nu) * nphi + p.q0;
-          const float ws[4] = {(1.0f - p.ts) * (1.0f - p.tq), (1.0f - p.ts) * p.tq, p.ts * (1.0f - p.tq), p.ts * p.tq};
-          // A corner of weight 0 reads the first one (its own cell may lie past the table's
-          // end: the last azimuth or sun node with t = 0).
-          const size_t sofs[4] = {so, ws[1] != 0.0f ? so + 1 : so, ws[2] != 0.0f ? so + nu * nphi : so,
-                                  ws[3] != 0.0f ? so + nu * nphi + 1 : so};
+          float ws[4];
+          size_t sofs[4];
+          SunAzimuthCorners(p, so, nu * nphi, ws, sofs);
           const Family::Corners& c = f.rc[m];
           const float* v[16];
           float wv[16];
@@ -156,11 +159,7 @@ void TransportCells(const TransportContext& tc, const Table& Jin, const Table& L
           const float* gm = &f.g[m * nw];
           for (size_t w = 0; w < nw; ++w) acc[w] += gm[w] * jvp[w];
         }
-        if (f.ground) {
-          const double mus_g = (r * std::cos(ts) + f.d * nu_s) / R;
-          InterpE(nodes, E, std::acos(std::clamp(mus_g, -1.0, 1.0)), eg.data());
-          for (size_t w = 0; w < nw; ++w) acc[w] += f.trans_end[w] * static_cast<float>(albedo[w] / kPi) * eg[w];
-        }
+        if (f.ground) AddGroundReflection(nodes, *tc.md, f, r, ts, nu_s, E, eg.data(), acc.data());
         std::copy(acc.begin(), acc.end(), &(*Lout)[nodes.Cell(ri, si, k, q) * nw]);
       }
     }

@@ -44,6 +44,22 @@ void GroundIrradiance(const Nodes& nodes, int ndn, const Table& L, std::vector<f
 // E interpolated to sun zenith theta_s (0 beyond the last sun node).
 void InterpE(const Nodes& nodes, const std::vector<float>& E, double theta_s, float* out);
 
+// acc[w] += the ground's Lambertian reflection, at the end of family f's ray (cell at radius r, sun
+// zenith ts, scattering cosine nu), of the irradiance E; eg: scratch of nw floats.
+void AddGroundReflection(const Nodes& nodes, const Medium& md, const Family& f, double r, double ts, double nu,
+                         const std::vector<float>& E, float* eg, float* acc);
+
+// The 4 sun/azimuth corners of position p: weights ws and table offsets sofs from so, the lower
+// (sun, azimuth) corner, with sun_stride between sun nodes. A corner of weight 0 reads the first
+// one (its own cell may lie past the table's end: the last azimuth or sun node with t = 0).
+inline void SunAzimuthCorners(const SunAzimuth& p, size_t so, size_t sun_stride, float ws[4], size_t sofs[4]) {
+  ws[0] = (1.0f - p.ts) * (1.0f - p.tq), ws[1] = (1.0f - p.ts) * p.tq, ws[2] = p.ts * (1.0f - p.tq), ws[3] = p.ts * p.tq;
+  sofs[0] = so;
+  sofs[1] = ws[1] != 0.0f ? so + 1 : so;
+  sofs[2] = ws[2] != 0.0f ? so + sun_stride : so;
+  sofs[3] = ws[3] != 0.0f ? so + sun_stride + 1 : so;
+}
+
 // Lout = the transport of the sources Jin, plus the ground's reflection of Lin's irradiance.
 void Transport(const TransportContext& tc, const Table& Jin, const Table& Lin, Table* Lout);
 

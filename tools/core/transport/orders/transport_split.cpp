@@ -69,9 +69,9 @@ void AccumulateCells(const TransportContext& tc, const std::vector<float>& cfac,
     const SunAzimuth& p = x->pts[cell];
     if (p.si == kNoSun) continue;
     const size_t so = static_cast<size_t>(p.si) * nphi + p.q0;
-    const float ws[4] = {(1.0f - p.ts) * (1.0f - p.tq), (1.0f - p.ts) * p.tq, p.ts * (1.0f - p.tq), p.ts * p.tq};
-    // A corner of weight 0 reads the first one (it may lie past the table's end).
-    const size_t sofs[4] = {so, ws[1] != 0.0f ? so + 1 : so, ws[2] != 0.0f ? so + nphi : so, ws[3] != 0.0f ? so + nphi + 1 : so};
+    float ws[4];
+    size_t sofs[4];
+    SunAzimuthCorners(p, so, nphi, ws, sofs);
     const bool loglin = p.si >= tc.loglin_first && p.ts > 0.0f;
     float* jvp = x->jv.data();
     if (!loglin) {
@@ -94,7 +94,7 @@ void StoreFamily(const TransportContext& tc, const Family& f, size_t ri, size_t 
                  Table* Lout) {
   const Nodes& nodes = *tc.nodes;
   const size_t nw = tc.md->nw, nphi = static_cast<size_t>(nodes.nphi);
-  const double R = nodes.bottom_radius_m, r = nodes.radius[ri];
+  const double r = nodes.radius[ri];
   for (size_t si = 0; si < nodes.ns; ++si) {
     const double ts = nodes.sun_theta_rad[si];
     for (size_t q = 0; q < nphi; ++q) {
@@ -102,9 +102,7 @@ void StoreFamily(const TransportContext& tc, const Family& f, size_t ri, size_t 
       if (f.ground) {
         double mu, nu;
         nodes.CellGeometry(ri, si, k, q, &mu, &nu);
-        const double mus_g = (r * std::cos(ts) + f.d * nu) / R;
-        InterpE(nodes, E, std::acos(std::clamp(mus_g, -1.0, 1.0)), x->eg.data());
-        for (size_t w = 0; w < nw; ++w) a[w] += f.trans_end[w] * static_cast<float>(tc.md->albedo[w] / kPi) * x->eg[w];
+        AddGroundReflection(nodes, *tc.md, f, r, ts, nu, E, x->eg.data(), a);
       }
       std::copy(a, a + nw, &(*Lout)[nodes.Cell(ri, si, k, q) * nw]);
     }
