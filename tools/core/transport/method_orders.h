@@ -27,6 +27,8 @@
 //    output's sun angle, which is interpolated log-linearly (twilight light decays
 //    exponentially with the sun's depression).
 // Everything is vectorised over wavelength (float, wavelength innermost).
+// The implementation, one phase per file: transport/orders/ (settings, medium, sun_tables, nodes,
+// rays, kernel, modal_kernel, transport, transport_split, solve, render, simd; method.cpp).
 #pragma once
 
 #include <memory>

@@ -1,0 +1,79 @@
+// Small pieces shared by the phases of `orders`: the solve's tables, interpolation positions on
+// sorted grids, and node placement uniform in a monotone parameter.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <memory>
+#include <numbers>
+#include <utility>
+#include <vector>
+
+#include "io/interp.h"
+
+namespace skybake::orders {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kDeg = kPi / 180.0;
+
+// The solve's tables (a field over every cell and wavelength: 178 MB for high) in vectors whose
+// elements start uninitialised, zeroed in parallel by ZeroTable: a std::vector<float> of that
+// size is zeroed on one thread, and so is the kernel's zeroing of the fresh pages on first touch
+// (~1.8 GB for high, ~2.5 s of system time at 2 threads). The same values, the same bytes.
+template <class T>
+struct UninitAllocator : std::allocator<T> {
+  template <class U>
+  struct rebind {
+    using other = UninitAllocator<U>;
+  };
+  UninitAllocator() = default;
+  template <class U>
+  UninitAllocator(const UninitAllocator<U>&) noexcept {}
+  template <class U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... A>
+  void construct(U* p, A&&... a) {
+    ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
+  }
+};
+using Table = std::vector<float, UninitAllocator<float>>;
+
+// v = n zeros, written in parallel blocks (the first touch of fresh pages spread over the threads).
+void ZeroTable(Table* v, size_t n);
+
+// Linear interpolation position on a sorted grid: index of the lower node and weight of the upper.
+struct Lerp {
+  size_t i = 0;
+  double t = 0.0;
+};
+[[gnu::always_inline]] inline Lerp Locate(const IntervalLocator& loc, double v) {
+  const std::vector<double>& x = loc.x();
+  if (v <= x.front()) return {0, 0.0};
+  if (v >= x.back()) return {x.size() - 2, 1.0};
+  const size_t i = loc.Find(v);
+  return {i, (v - x[i]) / (x[i + 1] - x[i])};
+}
+Lerp Locate(const std::vector<double>& x, double v);
+
+// n altitudes in [0, H] uniform in a monotone s(h) with s(0) = 0 and s(H) = 1 (bisection to 1 mm;
+// the ends exactly 0 and H): the node placements that follow both altitude and optical depth.
+template <class S>
+std::vector<double> AltitudesUniformIn(const S& s_of, int n, double H) {
+  std::vector<double> h;
+  for (int i = 0; i < n; ++i) {
+    const double u = static_cast<double>(i) / (n - 1);
+    double lo = 0.0, hi = H;
+    if (i == 0) hi = 0.0;
+    if (i == n - 1) lo = H;
+    for (int it = 0; it < 60 && hi - lo > 1e-3; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (s_of(mid) < u ? lo : hi) = mid;
+    }
+    h.push_back(0.5 * (lo + hi));
+  }
+  return h;
+}
+
+}  // namespace skybake::orders

@@ -1,0 +1,78 @@
+// The resolved settings of `orders`: table sizes, the quality presets, and the named expert
+// overrides of SkyMethodOptions::table_size (docs/sky-methods.md, "orders").
+#pragma once
+
+#include <vector>
+
+#include "transport/sky_method.h"
+
+namespace skybake::orders {
+
+struct OrdersSettings {
+  int nr = 16;               // radius nodes (+ the observer's)
+  int nup = 16, ndn = 8;     // view nodes above / below each altitude's horizon
+  int nphi = 8;              // azimuth nodes on [0, pi]
+  int nt = 40;               // steps along a table ray
+  // Steps along an output view ray (single scattering): 64 keep the sky within 0.016 % RMS,
+  // max 0.055 %, of 96 (hazed, clear, cloudy4; sun 30-95 deg).
+  int nss = 64;
+  int fine = 256;            // pieces for optical depths along a ray
+  // Truncation cone per scattering component, between truncation_min_deg and truncation_deg
+  // (chosen in PrepareMedium; "Truncation cone per component" in docs/sky-methods.md).
+  double truncation_deg = 5.0;
+  double truncation_min_deg = 0.0;  // 0: the same as truncation_deg (one cone for all)
+  double tau_cap = 12.0;     // optical depth beyond which a table ray's steps follow distance only
+  double rho_cap = 0.98;     // largest ratio of successive orders the geometric tail extrapolates
+  // The sun transmittance tables: radius nodes, and the sun-zenith node spacing from 80 to 110 deg.
+  // log T is blended linearly between radius nodes and is convex there, so too few nodes make a
+  // low sun's transmittance low: the hazed sky's single scattering at sun 85 deg is 0.36 % dark
+  // with 48 nodes, 0.09 % with 96, 0.03 % with 200, against the path tracer's first order (0.2 %
+  // references), while 0.05 and 0.1 deg zenith steps differ by <= 0.03 % even in twilight
+  // ("Sun transmittance" in docs/sky-methods.md).
+  int sun_nr = 96;
+  double sun_low_step_deg = 0.1;
+  // Sun-node intervals from here on: J blended log-linearly in the sun angle (> 180: never); the
+  // sun nodes from 80 to 90 deg are 1 deg apart ("The sun on the horizon" in docs/sky-methods.md).
+  double loglin_from_deg = 85.0;
+  double view_power = 2.0;   // view nodes: power of the node spacing in angle from the horizon
+  bool normalise = true;     // kernel rows scaled to conserve energy
+  bool azimuth_even = true;  // azimuth blends even about the sun's plane (phi^2 near 0 and pi)
+  bool early_tail = true;    // stop with the geometric tail once it is accurate to `tolerance`
+  // Scattering kernel: 0 = the phase sampled at the direction nodes (each node standing for its
+  // cell); n > 0 = integrated against the interpolation's own basis (the "hat" of each node, linear
+  // in the view-node index and in the azimuth blend) with n sub-intervals per view interval and
+  // 2n per azimuth interval ("Scattering kernel" in docs/sky-methods.md).
+  int kernel_sub = 0;
+  // The kernel applied in azimuthal cosine modes (the phase depends on the azimuth difference
+  // only: a circulant in the azimuth, plus the even blend's two end intervals as explicit
+  // columns); false: the (nd x nd) matrix, the slow and plain form the modal one is tested
+  // against ("Scattering kernel" in docs/sky-methods.md).
+  bool kernel_modal = true;
+  // The transport's gather by families (radius/view corners blended once per step for all sun and
+  // azimuth nodes); false: cell by cell, 16 corners each (the plain form).
+  bool gather_split = true;
+  // The output's exact single scattering (full phase) attenuated on the sun's path by the
+  // delta-scaled medium (Nakajima & Tanaka 1988's TMS correction: L = L1[P, T*] + L*_ms; the view's
+  // path: ss_scaled_view), in the sky and in view segments, when there are multiple-scattering
+  // orders; false, or max_orders 1: by the unscaled medium (the true first order). With the
+  // unscaled attenuation the light scattered into the truncation cone on the way - not scattered,
+  // in the delta-scaled problem - is counted by neither term: under a thin water cloud (cloudy1,
+  // tau 1, the droplets' 5 deg cone holding 45 % of their scattering) the sky comes out 17-53 %
+  // dark against the path tracer (docs/sky-methods.md "TMS attenuation").
+  bool ss_scaled = true;
+  // The view path's part of it: 1 = scaled for the components whose cone holds at least
+  // kViewScaledFraction of their scattering (cloud droplets), unscaled for the rest; 2 = scaled
+  // for all; 0 = unscaled for all (docs/sky-methods.md "TMS attenuation").
+  int ss_scaled_view = 1;
+  // Largest share of the total the geometric tail may have when taken early (StopRule in solve.cpp).
+  double tail_share_max = 0.1;
+  int max_orders = 40;
+  double tolerance = 1e-3;
+  std::vector<double> sun_deg;  // sun zenith nodes
+};
+
+// The preset of options.quality with options' overrides; UsageError for an unknown quality or
+// table sizes too small.
+OrdersSettings SettingsFor(const SkyMethodOptions& options);
+
+}  // namespace skybake::orders

@@ -1,0 +1,31 @@
+// Multiple scattering by successive orders on the tables (Bruneton & Neyret 2008 §4): order 1 of
+// the delta-scaled problem at every node, then per order the scattering step (kernel.h) and the
+// transport step (transport.h), until the next order adds less than `tolerance` of the
+// accumulated L_ms at the observer, or after `max_orders` (with a geometric tail once the ratio of
+// successive orders has settled).
+#pragma once
+
+#include <vector>
+
+#include "transport/orders/grid.h"
+#include "transport/orders/medium.h"
+#include "transport/orders/nodes.h"
+#include "transport/orders/sun_tables.h"
+#include "transport/sky_method.h"
+
+namespace skybake::orders {
+
+struct SolveResult {
+  std::vector<float> ms;  // accumulated orders >= 2 at the observer radius: [(si*nu+k)*nphi+q]*nw
+  // Accumulated multiple-scattering source J_ms* = sum_{n>=2} J_n at every node (cells x nw),
+  // for view segments: L_seg,ms = int_0^t_end T* J_ms* dt.
+  Table jms;
+  int orders_done = 0;
+  bool tail = false;
+  double last_fraction = 0.0;
+};
+
+SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, const SunTables& sun, const Nodes& nodes,
+                                    const OrdersSettings& s, const ProgressFn& progress);
+
+}  // namespace skybake::orders

@@ -1,0 +1,77 @@
+// The transport step of `orders`: L_n = int T* sigma_s* J_n dt along every table ray (the step
+// weights of rays.h) plus the ground's Lambertian reflection of the irradiance of L_{n-1}.
+#pragma once
+
+#include <vector>
+
+#include "transport/orders/rays.h"
+
+namespace skybake::orders {
+
+// Twilight: between two sun nodes the sources fall ~e-fold per degree, and a linear blend of the
+// two nodes' J along a table ray overestimates the sky (clear, 1 deg nodes against 0.2 deg:
+// +4-5 % RMS, up to 9 %, at sun 95-100 deg, at the nodes themselves). The exact log-linear blend
+// would cost two transcendentals per wavelength in the innermost loop, so it is approximated by a
+// factor on the linear blend, C = gbar_0^(1-t) gbar_1^t / ((1-t) gbar_0 + t gbar_1), gbar the mean
+// J over the directions at the radius node and sun node (exact when the nodes' J have the same
+// shape): tabulated per order at kLogBins + 1 values of t, per radius node, sun interval and
+// wavelength, for the intervals from loglin_from_deg on.
+constexpr size_t kLogBins = 16;
+
+struct TransportContext {
+  const AtmosphereModel* m = nullptr;
+  const Medium* md = nullptr;
+  const Nodes* nodes = nullptr;
+  const OrdersSettings* s = nullptr;
+  const std::vector<Family>* fam = nullptr;
+  // The sun/azimuth interpolation position of every (cell, step), [Cell * nt + step], shared by
+  // all orders (saves two acos and a node search per lookup and order; order 1 fills it); empty
+  // (computed per lookup) if it would take more than 768 MiB.
+  std::vector<SunAzimuth> sun_az;
+  size_t loglin_first = 0;  // the first sun interval blended log-linearly (ns: none)
+  size_t nd = 0;            // directions per (radius, sun)
+
+  // Cell (ri, si, k, q)'s position at step `step` of family f.
+  SunAzimuth StepPosition(const Family& f, size_t step, size_t ri, size_t si, size_t k, size_t q) const;
+};
+
+TransportContext MakeTransportContext(const AtmosphereModel& m, const Medium& md, const Nodes& nodes, const OrdersSettings& s,
+                                      const std::vector<Family>& fam);
+
+// E[si * nw + w]: the irradiance at the ground from a radiance table (upper view nodes at radius
+// node 0), the sum over the up nodes and both azimuth halves of L mu dOmega.
+void GroundIrradiance(const Nodes& nodes, int ndn, const Table& L, std::vector<float>* E);
+// E interpolated to sun zenith theta_s (0 beyond the last sun node).
+void InterpE(const Nodes& nodes, const std::vector<float>& E, double theta_s, float* out);
+
+// acc[w] += the ground's Lambertian reflection, at the end of family f's ray (cell at radius r, sun
+// zenith ts, scattering cosine nu), of the irradiance E; eg: scratch of nw floats.
+void AddGroundReflection(const Nodes& nodes, const Medium& md, const Family& f, double r, double ts, double nu,
+                         const std::vector<float>& E, float* eg, float* acc);
+
+// The 4 sun/azimuth corners of position p: weights ws and table offsets sofs from so, the lower
+// (sun, azimuth) corner, with sun_stride between sun nodes. A corner of weight 0 reads the first
+// one (its own cell may lie past the table's end: the last azimuth or sun node with t = 0).
+inline void SunAzimuthCorners(const SunAzimuth& p, size_t so, size_t sun_stride, float ws[4], size_t sofs[4]) {
+  ws[0] = (1.0f - p.ts) * (1.0f - p.tq), ws[1] = (1.0f - p.ts) * p.tq, ws[2] = p.ts * (1.0f - p.tq), ws[3] = p.ts * p.tq;
+  sofs[0] = so;
+  sofs[1] = ws[1] != 0.0f ? so + 1 : so;
+  sofs[2] = ws[2] != 0.0f ? so + sun_stride : so;
+  sofs[3] = ws[3] != 0.0f ? so + sun_stride + 1 : so;
+}
+
+// Lout = the transport of the sources Jin, plus the ground's reflection of Lin's irradiance.
+void Transport(const TransportContext& tc, const Table& Jin, const Table& Lin, Table* Lout);
+
+// The two forms: cell by cell, 16 corners each (the plain one), and by families (the fast one).
+void TransportCells(const TransportContext& tc, const Table& Jin, const Table& Lin, Table* Lout);
+void TransportSplit(const TransportContext& tc, const Table& Jin, const Table& Lin, Table* Lout);
+
+// The twilight factors C of Jin, [((ri * ns + si) * (kLogBins + 1) + b) * nw + w] for si >=
+// loglin_first (empty if none), and their blend of a step's gathered J: jlo (the lower radius's
+// corners) and jhi (the upper's) each times its factor at the step's sun interval, interpolated
+// between the kLogBins + 1 tabulated t; the result in jlo.
+std::vector<float> LogLinFactors(const TransportContext& tc, const Table& Jin);
+void LogBlend(const TransportContext& tc, const std::vector<float>& cfac, const SunAzimuth& p, size_t r0, float* jlo, const float* jhi);
+
+}  // namespace skybake::orders

@@ -1,0 +1,139 @@
+// The transport by families: all cells of a family (radius node, view node) share each step's
+// point and so its 4 radius/view corners. Per step, the radius/view blend of J is formed once for
+// every sun and azimuth node (a slab of ns x nphi x nw, which stays in cache), and each cell then
+// blends 4 sun/azimuth corners of the slab: 4 + 4 products per wavelength per cell instead of 16,
+// and the cells' reads go to the slab instead of 16 scattered table rows. The same sums in another
+// order: the result differs from TransportCells by float rounding
+// (MethodOrders.SplitGatherIsTheCellGather).
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+
+#include "transport/orders/simd.h"
+#include "transport/orders/transport.h"
+
+namespace skybake::orders {
+
+namespace {
+
+// One family's working set: slab[(s * nphi + q) * nw + w], the sum over the 4 radius/view
+// corners; lo / hi: the lower and the upper radius's 2 corners apart (twilight's log-linear
+// factor), for s >= loglin_first; acc: the family's cells; pts: their positions at a step.
+struct FamilyScratch {
+  std::vector<float> slab, lo, hi, acc, jv, jv2, eg;
+  std::vector<SunAzimuth> pts;
+  FamilyScratch(size_t plane, size_t nw)
+      : slab(plane * nw), lo(plane * nw), hi(plane * nw), acc(plane * nw), jv(nw), jv2(nw), eg(nw), pts(plane) {}
+};
+
+// The cells' sun/azimuth positions at step m into x->pts, and the sun nodes [*s_lo, *s_hi] they read.
+void StepPositions(const TransportContext& tc, const Family& f, size_t m, size_t ri, size_t k, FamilyScratch* x, size_t* s_lo,
+                   size_t* s_hi) {
+  const size_t ns = tc.nodes->ns, nphi = static_cast<size_t>(tc.nodes->nphi);
+  *s_lo = ns, *s_hi = 0;
+  for (size_t si = 0; si < ns; ++si) {
+    for (size_t q = 0; q < nphi; ++q) {
+      const SunAzimuth p = tc.StepPosition(f, m, ri, si, k, q);
+      x->pts[si * nphi + q] = p;
+      if (p.si == kNoSun) continue;
+      *s_lo = std::min<size_t>(*s_lo, p.si);
+      *s_hi = std::max<size_t>(*s_hi, std::min<size_t>(p.si + 1, ns - 1));
+    }
+  }
+}
+
+// The slab of step m: J blended over the step's 4 radius/view corners for sun nodes s_lo..s_hi.
+void BlendSlab(const TransportContext& tc, const Table& Jin, const Family::Corners& c, size_t s_lo, size_t s_hi, FamilyScratch* x) {
+  const size_t nw = tc.md->nw, nu = tc.nodes->nu, nphi = static_cast<size_t>(tc.nodes->nphi);
+  for (size_t s = s_lo; s <= s_hi; ++s) {
+    const size_t so = s * nu * nphi;
+    const float* v[4];
+    for (int a = 0; a < 4; ++a) v[a] = &Jin[(c.off[a] + so) * nw];
+    const size_t n = nphi * nw;
+    float* out = &x->slab[s * n];
+    if (s < tc.loglin_first) {
+      Gather16(v, c.w, 0, 4, n, out);
+    } else {
+      Gather16(v, c.w, 0, 2, n, &x->lo[s * n]);
+      Gather16(v, c.w, 2, 4, n, &x->hi[s * n]);
+      for (size_t e = 0; e < n; ++e) out[e] = x->lo[s * n + e] + x->hi[s * n + e];
+    }
+  }
+}
+
+// Each cell's 4 sun/azimuth corners of the slab, times the step's weight gm, added to its acc.
+void AccumulateCells(const TransportContext& tc, const std::vector<float>& cfac, const float* gm, size_t r0, FamilyScratch* x) {
+  const size_t nw = tc.md->nw, nphi = static_cast<size_t>(tc.nodes->nphi), plane = tc.nodes->ns * nphi;
+  for (size_t cell = 0; cell < plane; ++cell) {
+    const SunAzimuth& p = x->pts[cell];
+    if (p.si == kNoSun) continue;
+    const size_t so = static_cast<size_t>(p.si) * nphi + p.q0;
+    float ws[4];
+    size_t sofs[4];
+    SunAzimuthCorners(p, so, nphi, ws, sofs);
+    const bool loglin = p.si >= tc.loglin_first && p.ts > 0.0f;
+    float* jvp = x->jv.data();
+    if (!loglin) {
+      const float* v[4] = {&x->slab[sofs[0] * nw], &x->slab[sofs[1] * nw], &x->slab[sofs[2] * nw], &x->slab[sofs[3] * nw]};
+      Gather16(v, ws, 0, 4, nw, jvp);
+    } else {
+      const float* vl[4] = {&x->lo[sofs[0] * nw], &x->lo[sofs[1] * nw], &x->lo[sofs[2] * nw], &x->lo[sofs[3] * nw]};
+      const float* vh[4] = {&x->hi[sofs[0] * nw], &x->hi[sofs[1] * nw], &x->hi[sofs[2] * nw], &x->hi[sofs[3] * nw]};
+      Gather16(vl, ws, 0, 4, nw, jvp);
+      Gather16(vh, ws, 0, 4, nw, x->jv2.data());
+      LogBlend(tc, cfac, p, r0, jvp, x->jv2.data());
+    }
+    float* a = &x->acc[cell * nw];
+    for (size_t w = 0; w < nw; ++w) a[w] += gm[w] * jvp[w];
+  }
+}
+
+// The family's cells: the ground's reflection of E where the ray ends on it, stored into Lout.
+void StoreFamily(const TransportContext& tc, const Family& f, size_t ri, size_t k, const std::vector<float>& E, FamilyScratch* x,
+                 Table* Lout) {
+  const Nodes& nodes = *tc.nodes;
+  const size_t nw = tc.md->nw, nphi = static_cast<size_t>(nodes.nphi);
+  const double r = nodes.radius[ri];
+  for (size_t si = 0; si < nodes.ns; ++si) {
+    const double ts = nodes.sun_theta_rad[si];
+    for (size_t q = 0; q < nphi; ++q) {
+      float* a = &x->acc[(si * nphi + q) * nw];
+      if (f.ground) {
+        double mu, nu;
+        nodes.CellGeometry(ri, si, k, q, &mu, &nu);
+        AddGroundReflection(nodes, *tc.md, f, r, ts, nu, E, x->eg.data(), a);
+      }
+      std::copy(a, a + nw, &(*Lout)[nodes.Cell(ri, si, k, q) * nw]);
+    }
+  }
+}
+
+}  // namespace
+
+void TransportSplit(const TransportContext& tc, const Table& Jin, const Table& Lin, Table* Lout) {
+  const Nodes& nodes = *tc.nodes;
+  const size_t nw = tc.md->nw, nu = nodes.nu, nr = nodes.radius.size();
+  std::vector<float> E;
+  GroundIrradiance(nodes, tc.s->ndn, Lin, &E);
+  const std::vector<float> cfac = LogLinFactors(tc, Jin);
+  const size_t plane = nodes.ns * static_cast<size_t>(nodes.nphi);  // cells of one family
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, nr * nu, 1), [&](const tbb::blocked_range<size_t>& rg) {
+    FamilyScratch x(plane, nw);
+    for (size_t fi = rg.begin(); fi != rg.end(); ++fi) {
+      const size_t ri = fi / nu, k = fi % nu;
+      const Family& f = (*tc.fam)[fi];
+      std::fill(x.acc.begin(), x.acc.end(), 0.0f);
+      for (size_t m = 0; m < f.t.size(); ++m) {
+        size_t s_lo, s_hi;
+        StepPositions(tc, f, m, ri, k, &x, &s_lo, &s_hi);
+        if (s_lo > s_hi) continue;
+        BlendSlab(tc, Jin, f.rc[m], s_lo, s_hi, &x);
+        AccumulateCells(tc, cfac, &f.g[m * nw], f.rv[m].ri, &x);
+      }
+      StoreFamily(tc, f, ri, k, E, &x, Lout);
+    }
+  });
+}
+
+}  // namespace skybake::orders
