@@ -43,12 +43,8 @@ REPO_PATH = re.compile(r"(?<![\w./-])((?:" + TOP_DIRS + r")/[\w./-]*[\w])")
 CORE_PATH = re.compile(r"(?<![\w./-])((?:" + CORE_MODULES + r")/[\w-]+\.(?:h|cpp))\b")
 SECTION = re.compile(r"(?<![\w./-])(?:docs/)?(sky-methods|benchmarks)\.md`?,? (?:\"([^\"\n]{1,100})\"|“([^”\n]{1,100})”)")
 PATTERN_CHARS = "*{<$["
-# Offenders in the files of the `orders` method, which issue 23 item 1 splits and rewrites: listed
-# here as (file, start of the offence), and each must still offend (delete its line when fixed).
-KNOWN = {
-    ("tools/core/transport/method_orders.h", "outside the repository: ../shared/seeds/bruneton2008"),
-    ("tools/core/transport/method_orders.cpp", 'docs/sky-methods.md "Cost cuts of 2026-11-24, sixth stop"'),
-}
+# Known offenders, as (file, start of the offence); each must still offend (delete its line when fixed).
+KNOWN = set()
 OTHER_REPO = re.compile(r"(?<![\w./-])[\w.-]+/[\w.-]+ $")
 
 

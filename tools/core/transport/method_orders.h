@@ -1,5 +1,5 @@
 // `orders`: deterministic multiple scattering by successive orders on precomputed tables
-// (Bruneton & Neyret 2008 §3-4; ../shared/seeds/bruneton2008-precomputed-atmospheric-scattering.md),
+// (Bruneton & Neyret 2008, "Precomputed Atmospheric Scattering", §3-4),
 // rebuilt for an offline CPU baker that must be accurate at the horizon and in twilight
 // (docs/sky-methods.md, "orders", has the derivation, the table layouts and the measured errors).
 //
