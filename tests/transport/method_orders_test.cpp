@@ -70,9 +70,9 @@ const std::vector<std::array<double, 3>>& SkyDirs() {
 // With no multiple-scattering orders (max_orders 1) `orders` is its exact single scattering plus
 // the ground's reflection of the direct sun. Against the path tracer's first order (max_order 1,
 // 0.5 % references) on the horizon band with the sun 10 deg high, where the sun's transmittance
-// changes e-fold over a few hundred metres of altitude: measured -0.1 to +0.4 % (hazed, 10 nm grid;
-// before the sun table followed the optical depth and blended its logarithm, 2026-11-23: +6 to +7 %
-// there, and +7.6 % at 87 deg with the sun at 85 deg). Against `single` (a different march:
+// changes e-fold over a few hundred metres of altitude (the sun table's radius nodes follow the
+// optical depth and it blends the transmittance's logarithm): measured -0.1 to +0.4 % (hazed, 10 nm
+// grid), bound 1.5 %. Against `single` (a different march:
 // altitude ladder, its own transmittance table): <= 0.5 % at sun 30 deg; at sun 80 deg `single`
 // medium is 2.4-3.6 % above both on the horizon band (measured), so that bound is 4 %.
 TEST(MethodOrders, FirstOrderIsTheSingleScattering) {
@@ -108,19 +108,16 @@ TEST(MethodOrders, FirstOrderIsTheSingleScattering) {
 
 // All orders against the path tracer (all orders; 1.5 % standard error per direction, 2 % at
 // sun 90 deg), clear (aerosol tau_550 0.1) and hazed (0.5), on the 21-wavelength test grid,
-// medium tables. Measured (RMS / max over the 10 directions, noise included), 2026-11-23 (5 deg
-// truncation, exponential step integration, view nodes in angle, tail per settled element):
-//   clear: sun 30: 1.6 / 3.1 %, 70: 2.2 / 4.0 %, 85: 1.4 / 2.6 %, 90: 3.4 / 5.4 %
-//   hazed: sun 30: 1.6 / 2.8 %, 70: 2.4 / 4.2 %, 85: 2.9 / 5.5 %, 90: 3.4 / 7.0 %
-// (before, with a 15 deg truncation and the midpoint rule: clear 1.3 / 2.4, 1.9 / 3.7,
-// 1.9 / 3.8, 2.6 / 4.3 %; hazed 5.9 / 8.3, 6.3 / 14.1, 3.3 / 7.3, 2.9 / 4.9 %). With this
-// reference's noise (1.5 %) the clear rows are mostly noise: against 1 % references on 35
-// directions and 48 wavelengths the noise-corrected RMS is 0.5 / 1.0 / 1.2 / 2.1 % (clear) and
+// medium tables (5 deg truncation, exponential step integration, view nodes in angle, tail per
+// settled element, log-linear twilight sources in the build, the azimuth blend even about the
+// sun's plane). Measured (RMS / max over the 10 directions, noise included) at sun 30 / 70 / 85 /
+// 90 deg:
+//   clear: 1.6 / 3.1, 2.2 / 4.0, 1.4 / 2.2, 2.8 / 4.6 %
+//   hazed: 1.6 / 2.8, 2.3 / 4.3, 3.1 / 5.8, 3.2 / 7.2 % (noise-corrected 0.7 / 1.7 / 2.7 / 2.5 %)
+// With this reference's noise (1.5 %) the clear rows are mostly noise: against 1 % references on
+// 35 directions and 48 wavelengths the noise-corrected RMS is 0.5 / 1.0 / 1.2 / 2.1 % (clear) and
 // 0.9 / 2.9 / 2.4 / 1.5 % (hazed) at sun 30 / 70 / 85 / 90 deg (docs/sky-methods.md "orders").
-// Re-measured after the second stop of 2026-11-23 (log-linear twilight sources in the build, the
-// azimuth blend even about the sun's plane): clear 1.6 / 3.1, 2.2 / 4.0, 1.4 / 2.2, 2.8 / 4.6 %;
-// hazed 1.6 / 2.8, 2.3 / 4.3, 3.1 / 5.8, 3.2 / 7.2 % (noise-corrected hazed 0.7 / 1.7 / 2.7 /
-// 2.5 %). Twilight, sun 94 deg (elevation -4, the issue's -10...0 deg range: target RMS 3 %),
+// Twilight, sun 94 deg (elevation -4, the issue's -10...0 deg range: target RMS 3 %),
 // 3 % references (twilight paths are expensive): clear 4.6 / 7.1 % (noise-corrected 3.4 %),
 // hazed 5.6 / 14.1 % (4.7 %; the max at 89.5 deg, 60 deg from the sun), orders brighter in 8 of
 // 10 directions; the chart's 91 directions with 2 % references give clear 1.7 % at -4 deg.
@@ -163,10 +160,9 @@ TEST(MethodOrders, AgainstThePathTracerFromDaylightToTwilight) {
 
 // `high` against the path tracer at the issue's daylight target (RMS <= 0.5 %, max <= 2 % outside
 // the aureole) on the hazed sky with the sun 30 and 70 deg from the zenith: ten directions
-// (SkyDirs), 0.3 % references, a 10 nm grid (41 wavelengths). Measured here (2026-11-24, cones per
-// component, 192 sun-table radius nodes, 36 azimuths): noise-corrected RMS 0.43 / 0.21 %, max
-// 0.95 / 0.86 % (with 24 azimuths 0.49 / 0.41 %, 1.03 / 1.01 %); with the sun nodes 1 deg apart
-// from 80 deg and the two-change stopping rule (later on 2026-11-24) 0.42 / 0.25 %, max 0.93 / 0.94 %.
+// (SkyDirs), 0.3 % references, a 10 nm grid (41 wavelengths). Measured here (cones per component,
+// 192 sun-table radius nodes, 36 azimuths, the sun nodes 1 deg apart from 80 deg, the two-change
+// stopping rule): noise-corrected RMS 0.42 / 0.25 %, max 0.93 / 0.94 % at sun 30 / 70 deg.
 // On the 20 nm test grid the same code gives 0.67 / 0.42 % (+1.0 and +1.4 % at 40 deg across and
 // 60 deg away from the sun at sun 30 deg, where the 10 nm grid and the pipeline's 48-wavelength
 // grid give +0.4 to +1.0 %), so this test uses the finer grid. On the pipeline's grid with 35
@@ -196,10 +192,10 @@ TEST(MethodOrders, HighAtTheDaylightTargetOnTheHazedSky) {
 }
 
 // `high` with the sun on the horizon (sun zenith 90 deg), clear sky, on the horizon band 40 deg from
-// the sun's azimuth, 0.5 and 3 deg above the horizon, where the table build's sun nodes from 80 to
-// 90 deg 2.5 deg apart made it +4.7 / +2.6 % (0.3-0.37 % references, 48 wavelengths; since
-// 2026-11-24 1 deg with the log-linear blend from 85 deg: +0.13 / +0.30 %, docs/sky-methods.md "The
-// sun on the horizon"). Here ~0.85 % references (the path tracer's default cap of 2^20 paths) on
+// the sun's azimuth, 0.5 and 3 deg above the horizon, where the sources fall steeply between the
+// table build's sun nodes; with the nodes 1 deg apart from 80 deg and the log-linear blend from
+// 85 deg: +0.13 / +0.30 % against 0.3-0.37 % references on 48 wavelengths (docs/sky-methods.md
+// "The sun on the horizon"). Here ~0.85 % references (the path tracer's default cap of 2^20 paths) on
 // the 10 nm grid, bound: the issue's 2 % max; measured +0.84 / -0.30 % (59-95 s).
 TEST(MethodOrders, HighWithTheSunOnTheHorizonOnTheClearSky) {
   const TestScene sc = LoadTestScene("clear", TenNmGrid());
@@ -220,9 +216,9 @@ TEST(MethodOrders, HighWithTheSunOnTheHorizonOnTheClearSky) {
 // (docs/sky-methods.md "Scattering kernel"): hazed, sun 70 deg, five directions (the zenith, 10
 // deg from the sun, across, away from the sun at 80 deg, 30 deg off it at 85 deg), 0.5 %
 // references, the 21-wavelength test grid. Measured: `high`'s kernel (integrated against the
-// interpolation's basis, 24 azimuths, 3 deg truncation: high's settings of 2026-11-23; since
-// 2026-11-24 high has 36 azimuths and a 1 deg aerosol cone, within the same bounds) +0.2, -0.2,
-// +0.7, -0.5, +1.5 % (RMS 0.8 %); `medium`'s (phase at the nodes, 8 azimuths, 5 deg) -2.1, -3.8, +2.1, -0.4, +1.7 % (RMS
+// interpolation's basis) with 24 azimuths and one 3 deg cone +0.2, -0.2, +0.7, -0.5, +1.5 % (RMS
+// 0.8 %), and high's 36 azimuths and 1 deg aerosol cone within the same bounds; `medium`'s (phase
+// at the nodes, 8 azimuths, 5 deg) -2.1, -3.8, +2.1, -0.4, +1.7 % (RMS
 // 2.3 %); medium's kernel with a 3 deg cone -3.5 % at the zenith (the lobe counted as filling the
 // zenith node's cap, and the row normalisation taking the excess from every other direction).
 // Bounds: the measured figures plus the references' noise, and high at most 0.6 x medium's RMS.
@@ -351,13 +347,10 @@ TEST(MethodOrders, SameResultAtAnyThreadCount) {
 }
 
 // The sun on the horizon: inside the table build a table ray's sources are blended between the
-// sun nodes of each step's local sun angle, and between 87.5 and 90 deg (nodes 2.5 deg apart until
-// 2026-11-24, blended linearly) they fall steeply and convexly: the clear sky 0.5 deg above the
-// horizon, 40 deg from the sun's azimuth, came out +4.7 % (high; +5.5 % medium) against 0.37 %
-// path references. The default nodes (1 deg, log-linear from 85 deg) against 0.2 deg ones, on
-// the horizon band with the sun at 90 deg: within 1 % (measured -0.15 to -0.44 %; with the old
-// nodes +4.1 % at 89.5 deg and +1.9 % at 87 deg, 40 deg azimuth; docs/sky-methods.md "The sun on
-// the horizon").
+// sun nodes of each step's local sun angle, and from 80 to 90 deg they fall steeply and convexly.
+// The default nodes (1 deg from 80 deg, log-linear blend from 85 deg) against 0.2 deg ones
+// (low_sun_step_x10 2), medium, on the horizon band with the sun at 90 deg: within 1 % (measured
+// -0.15 to -0.44 %; docs/sky-methods.md "The sun on the horizon").
 TEST(MethodOrders, SunOnTheHorizonConvergedInTheSunNodes) {
   const TestScene sc = LoadTestScene("clear");
   const std::vector<std::array<double, 3>> dirs = {Dir(89.5, 40), Dir(89.5, 90), Dir(87, 40), Dir(80, 40), Dir(60, 40)};
@@ -407,16 +400,13 @@ TEST(MethodOrders, OrdersConvergeAndTheTailIsAccurate) {
 // A thin, optically thick, conservative layer - a 2 km water-cloud-like tent of optical depth 8
 // at 3.5-5.5 km, Henyey-Greenstein g = 0.8, over a ground of albedo 0.3 - where the successive
 // orders converge slowly (the ratio of successive orders creeps up to ~0.93) and the sources
-// change fast with altitude. History of this case against the path tracer (1 %) at the four
-// directions: the orders diverged (ratio 1.29) before the radius nodes followed the optical
-// depth; then -34, -47, -53, -40 % (isotropic scattering -77 to -81 %), because a table ray's
-// midpoint rule lost everything of a step of optical depth ~45 along the inside of the layer;
-// with the exponential step integration, view nodes in angle and the 5 deg truncation
-// (2026-11-23): +1.6, -7.4, -8.4, -11.4 % (isotropic, converged: +5.0, -2.0, -3.3, -5.3 %);
-// with the energy-conserving step weights (later the same day): +5.0, -2.1, -4.4, -6.2 % against
-// 1 % references (this test's 2 % references: +2.3, -3.4, -4.8, -5.1 %; isotropic +8.2, +3.8,
-// +2.4, +3.2 %). `medium` reaches its 40 orders here and ends with the geometric tail. The remaining error is
-// the view resolution (docs/sky-methods.md "Thick cloud layers").
+// change fast with altitude. The radius nodes follow the optical depth, a table ray's steps are
+// integrated exponentially with energy-conserving weights and take their sources at their
+// centroid in optical depth, and the view nodes are in angle. `medium` reaches its 40 orders here
+// and ends with the geometric tail (asserted). Against the path tracer (2 % references) at the
+// four directions, sun 30 deg: measured -0.4, +0.3, +1.5, +4.3 %; the bound, 7 %, is the worst of
+// those plus the references' noise. The remaining error is the view resolution
+// (docs/sky-methods.md "Thick cloud layers").
 // A lossless cloud layer of optical depth 8 (HG g 0.8) between 3.5 and 5.5 km, a tent in
 // extinction peaking at 4.5 km, over a ground of albedo 0.3, two wavelengths, unit sun.
 static AtmosphereModel ThickTentLayer() {
@@ -470,19 +460,16 @@ TEST(MethodOrders, ThickCloudLayerConvergesWithinItsMeasuredError) {
     std::printf("thick layer, dir %zu: orders %.5g path %.5g +- %.1f %%: %+.1f %%\n", d, y, ref[d].xyz[1],
                 100.0 * ref[d].xyz_stderr[1] / ref[d].xyz[1], 100.0 * e);
     EXPECT_TRUE(std::isfinite(y) && y > 0.0);
-    // Measured -0.4, +0.3, +1.5, +4.3 % (path 2 %) with the table-ray steps' points in optical
-    // depth and the exact scaled sun table (fifth stop of 2026-11-23); 0.023-0.051 before them,
-    // 0.016-0.114 before the energy-conserving step weights.
+    // Measured -0.4, +0.3, +1.5, +4.3 % (path 2 %).
     EXPECT_LT(std::abs(e), 0.07) << "dir " << d;
   }
 }
 
 // The table rays' quadrature through a thick layer: the sky under the tau-8 layer with 40 steps
 // per table ray (medium) and with 160. A step takes its sources at its centroid in optical
-// depth; at the centroid of a uniform medium (before the fifth stop of 2026-11-23) the step that
-// straddles the cloud's edge took them in the clear air, the sky depended on the step count
-// (40 -> 160 steps: +15 to +25 % with the exact scaled sun table), and only the old scaled table's
-// overestimate inside the cloud hid it. Measured now: 40 and 160 steps within 0.4 %.
+// depth, so the step that straddles the cloud's edge takes them where its optical depth lies, in
+// the cloud, and the sky does not depend on the step count. Measured: 40 and 160 steps within
+// 0.4 %.
 TEST(MethodOrders, TableRayStepsConvergeThroughAThickLayer) {
   const AtmosphereModel m = ThickTentLayer();
   const std::vector<std::array<double, 3>> dirs = {Dir(0, 0), Dir(60, 0), Dir(60, 180), Dir(85, 90)};
@@ -501,10 +488,9 @@ TEST(MethodOrders, TableRayStepsConvergeThroughAThickLayer) {
 }
 
 // Under cloudy5's deck (water droplets, optical depth 16) the orders converge: the geometric tail
-// is taken, and capping the orders at 40 or 80 gives the same sky. Before the step weights
-// conserved energy (2026-11-23) each order added as much as the last (ratio 1.00): the zenith
-// doubled from 40 to 80 orders and the LUT was whatever 40 orders gave. Measured: 40 vs 80 orders
-// within 0.01 % (pipeline grid); this grid (40 nm) within the bound below.
+// is taken, and capping the orders at 40 or 80 gives the same sky: the table rays' step weights
+// conserve energy, so each order adds less than the last and the tail settles. Measured: 40 vs 80
+// orders within 0.01 % (pipeline grid); this grid (40 nm) within the bound below.
 TEST(MethodOrders, OrdersConvergeUnderAThickWaterCloud) {
   SceneOptions so;
   so.step_nm = 40.0;
@@ -551,10 +537,11 @@ class ForwardLobePhase : public PhaseModel {
 // moves sunlight by a degree or two, so the sky away from the sun is the sky without it but for
 // the isotropic floor. The clear sky with such a layer of optical depth 1 at 3.5-5.5 km against the
 // clear sky with an isotropic layer of the floor's optical depth (0.005) there, medium, sun 50 deg,
-// the 35 directions 15 deg or more from the sun: within 1 % (measured 0.17 % RMS, max 0.29 %). With the unscaled attenuation of the exact single scattering
-// (table key ss_scaled 0, the form until 2026-11-24) the light scattered into the cone was counted
-// by neither term and the sky came out 57 % dark on average, 72 % at worst: what had put the thin
-// water cloud of cloudy1 17-53 % below the path tracer (docs/sky-methods.md "TMS attenuation").
+// the 35 directions 15 deg or more from the sun: within 1 % (measured 0.17 % RMS, max 0.29 %). With
+// ss_scaled 0 the exact single scattering is attenuated by the unscaled medium, the light scattered
+// into the cone is counted by neither term, and the sky comes out 57 % dark on average, 72 % at
+// worst (asserted: RMS above 20 %); that form puts the thin water cloud of cloudy1 17-53 % below
+// the path tracer (docs/sky-methods.md "TMS attenuation").
 TEST(MethodOrders, ForwardOnlyLayerLeavesTheSkyAwayFromTheSun) {
   const TestScene sc = LoadTestScene("clear");
   // The clear sky with a layer at 3.5-5.5 km of the forward scatterers (tau 1), and, as the
