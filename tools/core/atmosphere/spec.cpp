@@ -63,6 +63,23 @@ void EmitPlanet(YAML::Emitter& out, const AtmosphereSpec& spec) {
   out << YAML::EndMap;
 }
 
+// A layer's `name`: an identifier, unique among the layers of its list (`names`).
+std::string LayerName(YamlMap& layer, const char* what, std::set<std::string>* names) {
+  std::optional<YamlNode> node = layer.Get("name");
+  if (!node) {
+    layer.ErrorMissing("name", kIdentifierExpected);
+    return {};
+  }
+  std::optional<std::string> name = node->ToString(kIdentifierExpected);
+  if (!name) return {};
+  if (!IsIdentifier(*name)) {
+    node->ErrorExpected(kIdentifierExpected);
+  } else if (!names->insert(*name).second) {
+    node->Error(std::string(what) + " name '" + *name + "' is used twice");
+  }
+  return *name;
+}
+
 }  // namespace
 
 AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& default_name) {
@@ -163,17 +180,7 @@ AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& defau
       YamlMap layer = layer_node.ToMap("an aerosol layer (a mapping)");
       if (!layer.valid()) continue;
       AerosolLayerSpec a;
-      std::optional<YamlNode> name_node = layer.Get("name");
-      if (!name_node) {
-        layer.ErrorMissing("name", kIdentifierExpected);
-      } else if (std::optional<std::string> name = name_node->ToString(kIdentifierExpected)) {
-        if (!IsIdentifier(*name)) {
-          name_node->ErrorExpected(kIdentifierExpected);
-        } else if (!names.insert(*name).second) {
-          name_node->Error("aerosol layer name '" + *name + "' is used twice");
-        }
-        a.name = *name;
-      }
+      a.name = LayerName(layer, "aerosol layer", &names);
       if (std::optional<YamlNode> particle = layer.Get("particle")) {
         // A particle type is named by its file name (mie/<name>.exr).
         a.particle = particle->ToPath();
@@ -245,17 +252,7 @@ AtmosphereSpec ParseAtmosphere(const YamlDocument& doc, const std::string& defau
       YamlMap layer = layer_node.ToMap("an absorbing layer (a mapping)");
       if (!layer.valid()) continue;
       AbsorberSpec a;
-      std::optional<YamlNode> name_node = layer.Get("name");
-      if (!name_node) {
-        layer.ErrorMissing("name", kIdentifierExpected);
-      } else if (std::optional<std::string> name = name_node->ToString(kIdentifierExpected)) {
-        if (!IsIdentifier(*name)) {
-          name_node->ErrorExpected(kIdentifierExpected);
-        } else if (!names.insert(*name).second) {
-          name_node->Error("absorbing layer name '" + *name + "' is used twice");
-        }
-        a.name = *name;
-      }
+      a.name = LayerName(layer, "absorbing layer", &names);
       if (std::optional<YamlNode> c = layer.Get("absorption")) {
         if (std::optional<CoefficientSpectrum> cs = ParseCoefficientSpectrum(*c)) a.absorption = *cs;
       } else {

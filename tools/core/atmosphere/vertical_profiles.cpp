@@ -12,6 +12,32 @@ namespace skybake {
 namespace {
 // Boltzmann constant (exact, SI 2019), J/K.
 constexpr double kBoltzmann = 1.380649e-23;
+// A layer's profile on the grid normalised to a unit column (trapezoid rule); `what` names the
+// layer in the error for a profile that is zero everywhere on the grid.
+VerticalProfiles::Aerosol LayerShape(const AtmosphereSpec& spec, const std::string& name, const ProfileSpec& profile,
+                                     const char* what, const std::vector<double>& z,
+                                     std::vector<std::filesystem::path>* inputs_read) {
+  VerticalProfiles::Aerosol out;
+  out.name = name;
+  std::vector<double> raw;
+  if (const auto* tb = std::get_if<TableProfile>(&profile)) {
+    LoadedTable table = LoadProfileTable(*tb);
+    inputs_read->push_back(tb->file);
+    raw = SampleShape(*tb, z, &table);
+  } else {
+    raw = SampleShape(profile, z, nullptr);
+  }
+  out.raw_column = Trapezoid(z, raw);
+  out.raw_peak = raw.empty() ? 0.0 : *std::max_element(raw.begin(), raw.end());
+  if (!(out.raw_column > 0.0)) {
+    throw InputError(FileLoc{spec.file.string(), 0},
+                     std::string(what) + " '" + name + "': the profile is zero everywhere on the altitude grid");
+  }
+  out.shape_per_m.resize(z.size());
+  for (size_t i = 0; i < z.size(); ++i) out.shape_per_m[i] = raw[i] / out.raw_column;
+  return out;
+}
+
 }  // namespace
 
 VerticalProfiles ComputeProfiles(const AtmosphereSpec& spec) {
@@ -120,50 +146,12 @@ VerticalProfiles ComputeProfiles(const AtmosphereSpec& spec) {
     p.ozone_column_du = column / kDobsonUnitM2;
   }
 
-  // Aerosol shapes.
+  // Aerosol and absorbing-layer shapes.
   for (const AerosolLayerSpec& a : spec.aerosols) {
-    VerticalProfiles::Aerosol out;
-    out.name = a.name;
-    std::vector<double> raw;
-    if (const auto* tb = std::get_if<TableProfile>(&a.profile)) {
-      LoadedTable table = LoadProfileTable(*tb);
-      p.inputs_read.push_back(tb->file);
-      raw = SampleShape(*tb, z, &table);
-    } else {
-      raw = SampleShape(a.profile, z, nullptr);
-    }
-    out.raw_column = Trapezoid(z, raw);
-    out.raw_peak = raw.empty() ? 0.0 : *std::max_element(raw.begin(), raw.end());
-    if (!(out.raw_column > 0.0)) {
-      throw InputError(FileLoc{spec.file.string(), 0},
-                       "aerosol layer '" + a.name + "': the profile is zero everywhere on the altitude grid");
-    }
-    out.shape_per_m.resize(n);
-    for (size_t i = 0; i < n; ++i) out.shape_per_m[i] = raw[i] / out.raw_column;
-    p.aerosols.push_back(std::move(out));
+    p.aerosols.push_back(LayerShape(spec, a.name, a.profile, "aerosol layer", z, &p.inputs_read));
   }
-
-  // Absorbing-layer shapes, normalised like the aerosols'.
   for (const AbsorberSpec& a : spec.absorbers) {
-    VerticalProfiles::Aerosol out;
-    out.name = a.name;
-    std::vector<double> raw;
-    if (const auto* tb = std::get_if<TableProfile>(&a.profile)) {
-      LoadedTable table = LoadProfileTable(*tb);
-      p.inputs_read.push_back(tb->file);
-      raw = SampleShape(*tb, z, &table);
-    } else {
-      raw = SampleShape(a.profile, z, nullptr);
-    }
-    out.raw_column = Trapezoid(z, raw);
-    out.raw_peak = raw.empty() ? 0.0 : *std::max_element(raw.begin(), raw.end());
-    if (!(out.raw_column > 0.0)) {
-      throw InputError(FileLoc{spec.file.string(), 0},
-                       "absorbing layer '" + a.name + "': the profile is zero everywhere on the altitude grid");
-    }
-    out.shape_per_m.resize(n);
-    for (size_t i = 0; i < n; ++i) out.shape_per_m[i] = raw[i] / out.raw_column;
-    p.absorbers.push_back(std::move(out));
+    p.absorbers.push_back(LayerShape(spec, a.name, a.profile, "absorbing layer", z, &p.inputs_read));
   }
   return p;
 }
