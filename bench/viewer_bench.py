@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The runtime viewer's cost (docs/runtime.md "Cost"): frame time and texture fetches per pixel in
+"""The runtime viewer's cost (docs/runtime.md "Measured"): frame time and texture fetches per pixel in
 headless Chromium. Prints a table; writes nothing outside its work folder.
 
   bench/viewer_bench.py [--outputs outputs] [--size 1280x720] [--frames 3] [--work /tmp/viewer_bench]

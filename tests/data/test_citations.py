@@ -14,8 +14,8 @@ Python docstrings), in Markdown the whole text. Checked:
   inside another repository (after `owner/name `, e.g. `ovidiopr/scattnlay tests/test_py.py`) is not
   checked;
 - every core path `<module>/<file>.h|.cpp` (the modules of tools/core) exists in tools/core;
-- every section cited as `docs/sky-methods.md "Name"` or `docs/benchmarks.md "Name"` is a heading
-  or a bold label (`**Name...**`) of that doc.
+- every section cited as `docs/<doc>.md "Name"` (or `<doc>.md, "Name"`, for a doc of docs/ or the
+  top-level README.md) is a heading or a bold label (`**Name...**`) of that doc, or the start of one.
 Offenders are printed as `file:line: citation`.
 
 Runs with the standard library only: `python3 tests/data/test_citations.py` or through ctest
@@ -35,13 +35,12 @@ C_LIKE = {".h", ".hpp", ".cpp", ".cc", ".c", ".js", ".mjs", ".glsl", ".frag", ".
 HASH_COMMENTS = {".cmake", ".sh", ".yaml", ".yml", ".txt"}
 TOP_DIRS = "atmospheres|tools|tests|bench|scripts|docs|cmake|particles|ocio|viewer"
 CORE_MODULES = "atmosphere|color|fog|io|lut|noise|optics|spectrum|transport"
-SECTION_DOCS = ("docs/sky-methods.md", "docs/benchmarks.md")
 
 OUTSIDE = re.compile(r"\.\./shared\b|(?<![\w.])shared/(?:seeds|notes|data)/")
 MD_FILE = re.compile(r"(?<![\w./-])((?:[\w.-]+/)*[\w-]+\.md)\b")
 REPO_PATH = re.compile(r"(?<![\w./-])((?:" + TOP_DIRS + r")/[\w./-]*[\w])")
 CORE_PATH = re.compile(r"(?<![\w./-])((?:" + CORE_MODULES + r")/[\w-]+\.(?:h|cpp))\b")
-SECTION = re.compile(r"(?<![\w./-])(?:docs/)?(sky-methods|benchmarks)\.md`?,? (?:\"([^\"\n]{1,100})\"|“([^”\n]{1,100})”)")
+SECTION = re.compile(r"(?<![\w./-])(?:docs/)?([\w-]+)\.md`?,? (?:\"([^\"\n]{1,100})\"|“([^”\n]{1,100})”)")
 PATTERN_CHARS = "*{<$["
 # Known offenders, as (file, start of the offence); each must still offend (delete its line when fixed).
 KNOWN = set()
@@ -125,7 +124,8 @@ class Citations(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.names = FileNamesInRepo()
-        cls.labels = {doc: DocLabels(doc) for doc in SECTION_DOCS}
+        docs = [os.path.join("docs", f) for f in sorted(os.listdir(os.path.join(ROOT, "docs"))) if f.endswith(".md")]
+        cls.labels = {doc: DocLabels(doc) for doc in docs + ["README.md"]}
 
     def Exists(self, rel):
         return os.path.exists(os.path.join(ROOT, rel.rstrip(".")))
@@ -164,8 +164,10 @@ class Citations(unittest.TestCase):
                     if not self.Exists(os.path.join("tools", "core", m.group(1))):
                         Offend(m.group(1))
                 for m in SECTION.finditer(piece):
-                    doc = f"docs/{m.group(1)}.md"
+                    doc = "README.md" if m.group(1) == "README" else f"docs/{m.group(1)}.md"
                     section = m.group(2) or m.group(3)
+                    if doc not in self.labels:
+                        continue  # a doc that does not exist is reported above
                     if not any(label == section or label.startswith(section) for label in self.labels[doc]):
                         Offend(f'{doc} "{section}" (no such heading or bold label)')
         return offenders

@@ -126,7 +126,7 @@ TEST(FogModel, Geometry) {
 // A homogeneous low atmosphere of extinction sigma, uniformly lit: the fog to depth d is
 // S (1 - e^{-sigma d})/sigma, so Fog(x)/Fog(1) = F(x, sigma D) exactly, and sigma D =
 // sigma (c - h)/theta_path: the model with theta = path, p = -1, a = sigma (c - h) is exact in
-// every direction, the horizon included (docs/fog.md, "Which theta").
+// every direction, the horizon included (docs/fog.md, "Which θ").
 TEST(FogModel, ExactForHomogeneousLowAtmosphereWithPathAngle) {
   const FogGeometry g = Earth();
   const double sigma = 1.0 / 20e3;  // 20 km of extinction length (visibility ~ 78 km, Koschmieder 3.912/sigma)

@@ -1,4 +1,4 @@
-// Shared by the libFuzzer targets (tests/fuzz, docs/developing.md "Fuzzing"): a loader may
+// Shared by the libFuzzer targets (tests/fuzz, docs/developing.md "Sanitizers and fuzzing"): a loader may
 // reject any input with InputError or UsageError (exit 1 or 2 in a tool); anything else that
 // escapes - InternalError (a tool's exit 3), another exception, a sanitizer report, a signal -
 // is a crash of the target. SKYBAKE_SOURCE_DIR resolves the relative paths of the seeds (the

@@ -1,4 +1,4 @@
-// lut-pack's JSON documents (docs/lut-pack.md, "Report" and "Decode check"): written with
+// lut-pack's JSON documents (docs/lut-pack.md, "Outputs" and "Decode check"): written with
 // nlohmann::ordered_json (keys in a fixed order, numbers in shortest round-trip form), so the
 // same inputs give the same bytes.
 #pragma once

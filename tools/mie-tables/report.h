@@ -1,4 +1,4 @@
-// Text outputs of mie-tables (docs/mie.md, "CLI"): the single-sphere JSON, the build report
+// Text outputs of mie-tables (docs/mie.md, "Command line"): the single-sphere JSON, the build report
 // JSON and the CSV dumps. Numbers are written so that they read back exactly (shortest
 // round-trip form); nothing depends on time or thread count, so equal inputs give equal bytes.
 #pragma once

@@ -1,6 +1,6 @@
 // The reference evaluator of fog-fit's products: the runtime math a shader does to rebuild GT7's
 // global fog for any view direction, object depth and sun angle from the packed LUTs and the
-// fitted parameters (docs/fog.md, "Evaluator"; GT7 sky talk, "Fog").
+// fitted parameters (docs/fog.md, "The evaluator"; GT7 sky talk, "Fog").
 //
 //   mu     = the view direction's zenith cosine, clamped to [0, 1] (below the horizon: the horizon's
 //            geometry, fog/fog_model.h); the LUTs are read at the direction itself (their texels
@@ -10,7 +10,7 @@
 //   L_c    = fog LUT (GT7 sphere + time mappings, lut/decoder.h: bilinear, geometric slice blend)
 //   S_c    = shadowed fog LUT (the same without the single-scattered sun)
 //   F_c    = (1 - exp(-k_c x)) / (1 - exp(-k_c)),  k_c = a_c theta^p_c   (and k'_c for S)
-//   a_c, p_c: per-slice parameters (the default, docs/fog.md "Per-slice parameters"): slice k of
+//   a_c, p_c: per-slice parameters (the default, docs/fog.md "Where a and p live"): slice k of
 //            the fog LUT has its own (a, p) per channel, blended between the two slices the LUT
 //            reads with the LUT's own weight t (lut::SkyLutDecoder::SliceBlend, linear in the sun
 //            angle): a = (1 - t) a_i + t a_{i+1}, p likewise; beyond the last slice the last

@@ -9,7 +9,7 @@
 // bounded where the model is far off (the horizon with theta = elevation, where F -> 1 while f is
 // 1e-3 near the camera: relative residuals of 1000 would otherwise decide the fit).
 //
-// Stability (docs/fog.md, "Failure modes"):
+// Stability (docs/fog.md, "The fit"):
 //  - parameters are bounded by a smooth map, ln a = c_a + h_a tanh(q_a), p = c_p + h_p tanh(q_p),
 //    so the optimiser works on an unbounded q and can never leave [a_min, a_max] x [p_min, p_max];
 //  - the start is the best node of a 13 x 13 grid over the box (the cost is not convex: F saturates);

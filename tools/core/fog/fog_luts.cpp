@@ -722,7 +722,7 @@ std::string CompactNumberArrays(const std::string& text) {
   return out;
 }
 
-// The depth function's parameters as a tiny texture for a shader (docs/fog.md, "Files"):
+// The depth function's parameters as a tiny texture for a shader (docs/fog.md, "LUTs"):
 // R32G32B32A32_SFLOAT (a reaches 1e-5 on a Rayleigh-only sky: below half's normal range), W = 1 + nodes (1 without elevation nodes), H = slices, 2 layers (0 fog, 1
 // shadowed fog); texel (0, k) = (p_R, p_G, p_B, 0) of slice k, texel (1 + j, k) = (a_R, a_G, a_B, 1)
 // at elevation node j. Global parameters are written as the same row in every slice.
@@ -772,7 +772,7 @@ ktx2::Texture ParamsTexture(const FogProducts& p, const std::vector<double>& sli
   return tex;
 }
 
-// The residual PNG (docs/fog.md "Outputs"): a title; two panels, "fog" and "shadowed fog", each a
+// The residual PNG (docs/fog.md "LUTs"): a title; two panels, "fog" and "shadowed fog", each a
 // grid of tiles with one row per depth table (labelled with its sun zenith angle and elevation)
 // and one column per view azimuth from the sun (labelled); inside a tile depth samples run to the
 // right (nearest at the left) and elevation samples upwards (horizon at the bottom), kPx x kPx

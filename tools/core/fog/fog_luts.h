@@ -30,7 +30,7 @@
 
 namespace skybake::fog {
 
-// Where the depth function's parameters live (docs/fog.md, "Per-slice parameters").
+// Where the depth function's parameters live (docs/fog.md, "Where a and p live").
 //   kPerSlice  (a, p) per channel are fitted per depth table (sun angle), then, per slice of the fog
 //              LUT, interpolated in the slice's sun zenith angle (ln a and p linear between the
 //              tables' angles, constant beyond the first and the last); the evaluator blends them

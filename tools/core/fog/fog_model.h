@@ -6,7 +6,7 @@
 // r = R + h (R the planet radius, h the observer altitude); the "low atmosphere" is the shell
 // below the cut radius r_c = R + c (c the cut altitude: below the cloud base; docs/fog.md,
 // "The cut"). A view direction with zenith cosine mu is first clamped to the horizon,
-//   mu_c = max(mu, 0)                                                    (docs/fog.md, "Below the horizon")
+//   mu_c = max(mu, 0)                                                    (docs/fog.md, "The model")
 // and its boundary distance is the path from the observer to the cut sphere,
 //   D(mu) = -r mu_c + sqrt(r^2 mu_c^2 + r_c^2 - r^2)                  (ray-sphere, far root)
 // (D(1) = c - h straight up, D(0) = sqrt(r_c^2 - r^2) along the horizon: 112.9 km for c = 1 km,
@@ -19,7 +19,7 @@
 // with LUT = the fog of the whole segment (x = 1) and theta the normalised view angle:
 //   elevation:  theta = asin(mu_c) / (pi/2)                             (the talk's "normalized theta")
 //   path:       theta = (r_c - r) / D(mu)  = sin(elevation) on a flat planet, (c - h)/D(0) = 0.0089
-//               at the horizon for c = 1 km (skybake's default cut; docs/fog.md, "Which theta")
+//               at the horizon for c = 1 km (skybake's default cut; docs/fog.md, "Which θ")
 // For a homogeneous low atmosphere of extinction sigma lit uniformly, Fog(x)/Fog(1) is exactly
 // F(x, sigma D) and sigma D = sigma (c - h) / theta_path: the model with theta_path, p = -1 and
 // a = sigma (c - h) is exact, on the sphere and at the horizon; with theta_elevation it diverges
@@ -29,7 +29,7 @@
 // The attenuation LUT (the talk: "u = pow(normalized depth, 1/3), v = pow(normalized theta,
 // 1/2)") uses u = x^(1/3) and v = theta_elevation^(1/2) (always the elevation, so that the
 // horizon gets the densest rows whatever the fit's theta is); its texels are nodes at both ends,
-// texel i of N at u = i / (N - 1) (docs/fog.md, "Attenuation LUT").
+// texel i of N at u = i / (N - 1) (docs/fog.md, "Texel grid of the fog LUT").
 #pragma once
 
 #include <optional>

@@ -104,7 +104,7 @@ struct FogRender {
 // observer or above the top, bad sizes.
 FogRender RenderFog(const Scene& scene, const FogRenderOptions& options, const ProgressFn& progress);
 
-// The multi-part EXR (docs/fog.md, "Formats"): parts fog.slice_NN.sza_DDD.DD, depth.sza_DDD.DD,
+// The multi-part EXR (docs/fog.md, "Reference renders"): parts fog.slice_NN.sza_DDD.DD, depth.sza_DDD.DD,
 // depth_transmittance, attenuation, sun; provenance from the scene.
 void WriteFogRender(const Scene& scene, const FogRenderOptions& options, const FogRender& render,
                     const std::filesystem::path& path, const std::string& tool);

@@ -30,7 +30,7 @@ namespace skybake::mie {
 struct MieTable {
   std::string particle;                // particle type name
   std::vector<double> wavelength_nm;   // ascending
-  // Per wavelength, per particle of the mixture (docs/mie.md, "Per particle").
+  // Per wavelength, per particle of the mixture (docs/mie.md, "Particle types").
   std::vector<double> cext_m2, csca_m2, cabs_m2;
   std::vector<double> ssa;   // C_sca / C_ext
   std::vector<double> g;     // asymmetry parameter <cos theta>, from the Mie series

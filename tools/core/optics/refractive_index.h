@@ -1,6 +1,6 @@
 // The complex refractive index m(lambda) = n + i k of a particle material, relative to the
 // surrounding air (n_air - 1 < 3e-4 in the visible, below the accuracy of any aerosol index
-// table; docs/mie.md "Refractive index"), from a CSV table or a constant.
+// table; docs/mie.md "Particle types"), from a CSV table or a constant.
 //
 // Tables (atmospheres/data/*.csv, first line "# source: ..."): a wavelength column with a unit
 // suffix (wavelength_um, wavelength_nm), an n column and a k column (k >= 0: absorbing media
