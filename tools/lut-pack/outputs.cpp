@@ -10,34 +10,17 @@
 #include "lut/contact_sheet.h"
 #include "lut/dds.h"
 #include "lut/decoder.h"
+#include "lut/packed_files.h"
 
 namespace skybake::luttool {
 
 namespace {
 
-// R, G, B (decoded, physical units) + the packing error and the clamp flags of each texel.
-ExrImage InspectionImage(int width, int height, const lut::PackedTexture& t, const Provenance& prov) {
-  const ExrImage colour = MakeColorImage(width, height, t.decoded_rgb, ocio_names::kLinearRec2020);
-  ExrImage img;
-  img.Resize(width, height, {"R", "G", "B", "input_R", "input_G", "input_B", "clamp_flags"});
-  const size_t n = static_cast<size_t>(width) * height;
-  for (size_t i = 0; i < n; ++i) {
-    for (int c = 0; c < 3; ++c) {
-      img.pixels[i * 7 + c] = t.decoded_rgb[i * 3 + c];
-      img.pixels[i * 7 + 3 + c] = t.input_rgb[i * 3 + c];
-    }
-    img.pixels[i * 7 + 6] = t.clamp_flags[i];
-  }
-  img.chromaticities = colour.chromaticities;
-  img.strings = colour.strings;
-  img.strings["skybake.channels"] =
-      "R, G, B: the packed texels as a shader reads them, divided by the scale (physical units, Linear Rec.2020); "
-      "input_R/G/B: the values before packing; clamp_flags: 1 = a component above the format's largest value, "
-      "2 = a negative component (outside Rec.2020), 4 = a denormal component (bit OR)";
-  img.doubles["skybake.scale"] = t.scale;
-  SetProvenance(img, prov);
-  return img;
-}
+// skybake.channels of the inspection images.
+constexpr const char* kInspectionChannels =
+    "R, G, B: the packed texels as a shader reads them, divided by the scale (physical units, Linear Rec.2020); "
+    "input_R/G/B: the values before packing; clamp_flags: 1 = a component above the format's largest value, "
+    "2 = a negative component (outside Rec.2020), 4 = a denormal component (bit OR)";
 
 std::string Rows(const lut::LutSet& set) {
   std::string rows;
@@ -45,14 +28,6 @@ std::string Rows(const lut::LutSet& set) {
   return rows;
 }
 
-dds::Texture Dds(const lut::PackedTexture& t, bool volume) {
-  dds::Texture d;
-  d.width = static_cast<uint32_t>(t.width);
-  d.height = static_cast<uint32_t>(t.height);
-  d.depth = volume ? static_cast<uint32_t>(t.depth) : 0;
-  d.data = t.bytes;
-  return d;
-}
 
 }  // namespace
 
@@ -95,8 +70,8 @@ std::map<std::string, std::string> EncodeLutSet(const lut::LutSet& set, const Pr
     out[base + ".ktx2"] = ktx2::EncodeKtx2(volume);
     decoders.push_back(lut::SkyLutDecoder::FromKtx2(volume, base + ".ktx2"));
     out[base + "_array.ktx2"] = ktx2::EncodeKtx2(lut::SkyKtx2(set, s, true, sp));
-    out[base + ".dds"] = dds::EncodeDds(Dds(s.sky, true));
-    ExrImage img = InspectionImage(s.sky.width, s.sky.height * s.sky.depth, s.sky, sp);
+    out[base + ".dds"] = dds::EncodeDds(lut::PackedDds(s.sky, true));
+    ExrImage img = lut::PackedInspectionImage(s.sky.width, s.sky.height * s.sky.depth, s.sky, sp, kInspectionChannels);
     std::string zen;
     for (double z : s.render->slice_zenith_deg) zen += (zen.empty() ? "" : " ") + FormatExact(z);
     img.strings["skybake.layout"] = fmt::format("{} slices of {}x{} stacked top to bottom (slice k in rows {}k .. {}k + {})",
@@ -124,8 +99,8 @@ std::map<std::string, std::string> EncodeLutSet(const lut::LutSet& set, const Pr
   std::vector<ExrPart> parts;
   for (const Other& o : others) {
     out[std::string(o.name) + ".ktx2"] = ktx2::EncodeKtx2(lut::TableKtx2(set, *o.t, o.quantity, o.axis, prov));
-    out[std::string(o.name) + ".dds"] = dds::EncodeDds(Dds(*o.t, false));
-    ExrImage img = InspectionImage(o.t->width, o.t->height, *o.t, prov);
+    out[std::string(o.name) + ".dds"] = dds::EncodeDds(lut::PackedDds(*o.t, false));
+    ExrImage img = lut::PackedInspectionImage(o.t->width, o.t->height, *o.t, prov, kInspectionChannels);
     img.strings["skybake.quantity"] = o.quantity;
     img.strings["skybake.axis_u"] = o.axis;
     parts.push_back({o.name, std::move(img)});
