@@ -10,6 +10,7 @@
 #include "lut/contact_sheet.h"
 #include "lut/dds.h"
 #include "lut/decoder.h"
+#include "lut/inspection.h"
 
 namespace skybake::luttool {
 
@@ -17,24 +18,11 @@ namespace {
 
 // R, G, B (decoded, physical units) + the packing error and the clamp flags of each texel.
 ExrImage InspectionImage(int width, int height, const lut::PackedTexture& t, const Provenance& prov) {
-  const ExrImage colour = MakeColorImage(width, height, t.decoded_rgb, ocio_names::kLinearRec2020);
-  ExrImage img;
-  img.Resize(width, height, {"R", "G", "B", "input_R", "input_G", "input_B", "clamp_flags"});
-  const size_t n = static_cast<size_t>(width) * height;
-  for (size_t i = 0; i < n; ++i) {
-    for (int c = 0; c < 3; ++c) {
-      img.pixels[i * 7 + c] = t.decoded_rgb[i * 3 + c];
-      img.pixels[i * 7 + 3 + c] = t.input_rgb[i * 3 + c];
-    }
-    img.pixels[i * 7 + 6] = t.clamp_flags[i];
-  }
-  img.chromaticities = colour.chromaticities;
-  img.strings = colour.strings;
-  img.strings["skybake.channels"] =
+  ExrImage img = lut::PackedInspectionImage(
+      width, height, t,
       "R, G, B: the packed texels as a shader reads them, divided by the scale (physical units, Linear Rec.2020); "
       "input_R/G/B: the values before packing; clamp_flags: 1 = a component above the format's largest value, "
-      "2 = a negative component (outside Rec.2020), 4 = a denormal component (bit OR)";
-  img.doubles["skybake.scale"] = t.scale;
+      "2 = a negative component (outside Rec.2020), 4 = a denormal component (bit OR)");
   SetProvenance(img, prov);
   return img;
 }

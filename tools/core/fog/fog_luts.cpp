@@ -18,6 +18,7 @@
 #include "io/png_label.h"
 #include "io/yaml.h"
 #include "lut/dds.h"
+#include "lut/inspection.h"
 #include "lut/ktx2.h"
 #include "skybake/version.h"
 #include "spectrum/cmf.h"
@@ -565,25 +566,12 @@ std::string ElevationNodesText() {
 }
 
 ExrImage InspectionImage(int width, int height, const lut::PackedTexture& t, const Provenance& prov, const std::string& quantity) {
-  const ExrImage colour = MakeColorImage(width, height, t.decoded_rgb, ocio_names::kLinearRec2020);
-  ExrImage img;
-  img.Resize(width, height, {"R", "G", "B", "input_R", "input_G", "input_B", "clamp_flags"});
-  const size_t n = static_cast<size_t>(width) * height;
-  for (size_t i = 0; i < n; ++i) {
-    for (int c = 0; c < 3; ++c) {
-      img.pixels[i * 7 + c] = t.decoded_rgb[i * 3 + c];
-      img.pixels[i * 7 + 3 + c] = t.input_rgb[i * 3 + c];
-    }
-    img.pixels[i * 7 + 6] = t.clamp_flags[i];
-  }
-  img.chromaticities = colour.chromaticities;
-  img.strings = colour.strings;
-  img.strings["skybake.quantity"] = quantity;
-  img.strings["skybake.channels"] =
+  ExrImage img = lut::PackedInspectionImage(
+      width, height, t,
       "R, G, B: the packed texels as a shader reads them divided by the scale (physical units, Linear Rec.2020); "
       "input_R/G/B: before packing; clamp_flags: 1 = above the format's largest value, 2 = negative (outside "
-      "Rec.2020), 4 = denormal (bit OR)";
-  img.doubles["skybake.scale"] = t.scale;
+      "Rec.2020), 4 = denormal (bit OR)");
+  img.strings["skybake.quantity"] = quantity;
   SetProvenance(img, prov);
   return img;
 }
