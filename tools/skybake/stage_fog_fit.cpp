@@ -29,6 +29,7 @@
 #include "atmosphere/spec.h"
 #include "paths.h"
 #include "stage.h"
+#include "stage_helpers.h"
 #include "io/size.h"
 
 namespace skybake {
@@ -47,15 +48,7 @@ class FogFitStage : public Stage {
     quality_ = fog->ChoiceOr("quality", {"low", "medium", "high"}, quality_);
     stride_ = static_cast<int>(fog->IntegerOr("spectral_stride", 1, 64, "a whole number from 1 to 64", stride_));
     cut_km_ = fog->NumberOr("cut_altitude_km", NumberSpec::Range(0.001, 100.0, "km"), cut_km_);
-    if (std::optional<YamlNode> tm = fog->Get("time_mapping")) {
-      if (std::optional<std::string> s = tm->ToString()) {
-        if (!Gt7NameOk(*s)) {
-          tm->ErrorExpected("gt7 or gt7-quadratic, optionally with :<upper>+<lower> slices (e.g. gt7:3+2)");
-        } else {
-          time_mapping_ = *s;
-        }
-      }
-    }
+    time_mapping_ = TimeMappingOr(*fog, time_mapping_);
     lut_size_ = Size(*fog, "lut_size", lut_size_);
     attenuation_size_ = Size(*fog, "attenuation_size", attenuation_size_);
     if (std::optional<YamlMap> t = fog->OptionalMap("depth_tables")) {
@@ -98,26 +91,14 @@ class FogFitStage : public Stage {
       return s;
     };
     for (const auto& [name, loc] : skies_) {
-      const PipelineAtmosphere* a = nullptr;
-      for (const PipelineAtmosphere& p : ctx.pipeline().atmospheres) {
-        if (p.name == name) a = &p;
-      }
-      if (!a) {
-        std::string names;
-        for (const PipelineAtmosphere& p : ctx.pipeline().atmospheres) names += (names.empty() ? "" : ", ") + p.name;
-        diags.Add(loc, "fog.skies: '" + name + "' is not an atmosphere of this pipeline (" + names + ")");
-        continue;
-      }
+      const PipelineAtmosphere* a = FindAtmosphere(ctx.pipeline(), name, "fog.skies", loc, &diags);
+      if (!a) continue;
       NinjaBuild r;
       r.outputs = {paths::FogRender(a->name).generic_string()};
       r.rule = "fog_render";
       r.inputs = {paths::RenderComponent(a->name).generic_string()};
       r.implicit_inputs = {ctx.ToolPath("sky-render"), paths::Profiles(a->name).generic_string()};
-      std::set<std::string> particles;
-      for (const AerosolLayerSpec& layer : a->spec.aerosols) {
-        if (layer.particle) particles.insert(layer.particle->stem().string());
-      }
-      for (const std::string& p : particles) r.implicit_inputs.push_back(paths::MieTable(p).generic_string());
+      for (const std::string& mie : MieTableInputs(a->spec)) r.implicit_inputs.push_back(mie);
       r.variables = {{"args", fmt::format("fog --method {} --quality {} --spectral-stride {} --profiles {} --mie-dir mie --wavelengths {}:{}:{} "
                                           "--cut-altitude-km {} --lut-size {} --time-mapping {} --attenuation-size {} "
                                           "--sun-zenith-deg {} --elevations {} --azimuths-deg {} --depths {}",
@@ -140,17 +121,6 @@ class FogFitStage : public Stage {
   }
 
  private:
-  // Mirrors lut/gt7_mapping.h TimeMapping::ParseName (the generator does not link the lut module).
-  static bool Gt7NameOk(const std::string& s) {
-    const std::string base = s.substr(0, s.find(':'));
-    if (base != "gt7" && base != "gt7-quadratic") return false;
-    if (s.find(':') == std::string::npos) return true;
-    int u = 0, l = 0;
-    char tail = 0;
-    const std::string counts = s.substr(s.find(':') + 1);
-    return std::sscanf(counts.c_str(), "%d+%d%c", &u, &l, &tail) == 2 && u >= 2 && l >= 2 && u + l <= 4096 &&
-           counts == fmt::format("{}+{}", u, l);
-  }
   static std::string Size(YamlMap& m, std::string_view key, const std::string& fallback) {
     std::optional<YamlNode> n = m.Get(key);
     if (!n) return fallback;

@@ -27,6 +27,7 @@
 #include "atmosphere/spec.h"
 #include "paths.h"
 #include "stage.h"
+#include "stage_helpers.h"
 #include "io/size.h"
 
 namespace skybake {
@@ -56,15 +57,7 @@ class LutPackStage : public Stage {
     } else {
       spectral_stride_ = static_cast<int>(stride);
     }
-    if (std::optional<YamlNode> tm = luts->Get("time_mapping")) {
-      if (std::optional<std::string> s = tm->ToString()) {
-        if (!gt7_names_ok(*s)) {
-          tm->ErrorExpected("gt7 or gt7-quadratic, optionally with :<upper>+<lower> slices (e.g. gt7:3+2)");
-        } else {
-          time_mapping_ = *s;
-        }
-      }
-    }
+    time_mapping_ = TimeMappingOr(*luts, time_mapping_);
     if (std::optional<YamlNode> e = luts->Get("sky_exposure_stops")) {
       const std::optional<std::string> text = e->ToString("auto or a whole number of stops from -24 to 24");
       int stops = 0;
@@ -116,26 +109,14 @@ class LutPackStage : public Stage {
     Diagnostics diags;
     std::vector<std::pair<std::string, std::string>> packed;  // name, render path
     for (const LutSky& s : skies_) {
-      const PipelineAtmosphere* a = nullptr;
-      for (const PipelineAtmosphere& p : ctx.pipeline().atmospheres) {
-        if (p.name == s.atmosphere) a = &p;
-      }
-      if (!a) {
-        std::string names;
-        for (const PipelineAtmosphere& p : ctx.pipeline().atmospheres) names += (names.empty() ? "" : ", ") + p.name;
-        diags.Add(s.loc, "luts.skies: '" + s.atmosphere + "' is not an atmosphere of this pipeline (" + names + ")");
-        continue;
-      }
+      const PipelineAtmosphere* a = FindAtmosphere(ctx.pipeline(), s.atmosphere, "luts.skies", s.loc, &diags);
+      if (!a) continue;
       NinjaBuild b;
       b.outputs = {paths::LutRender(a->name).generic_string()};
       b.rule = "lut_render";
       b.inputs = {paths::RenderComponent(a->name).generic_string()};
       b.implicit_inputs = {ctx.ToolPath("sky-render"), paths::Profiles(a->name).generic_string()};
-      std::set<std::string> particles;
-      for (const AerosolLayerSpec& layer : a->spec.aerosols) {
-        if (layer.particle) particles.insert(layer.particle->stem().string());
-      }
-      for (const std::string& p : particles) b.implicit_inputs.push_back(paths::MieTable(p).generic_string());
+      for (const std::string& mie : MieTableInputs(a->spec)) b.implicit_inputs.push_back(mie);
       std::string args = fmt::format("render --method {} --quality {} --profiles {} --mie-dir mie --wavelengths {}:{}:{} "
                                      "--mapping gt7 --size {} --time-mapping {}",
                                      method_, s.quality, paths::Profiles(a->name).generic_string(),
@@ -166,18 +147,6 @@ class LutPackStage : public Stage {
   }
 
  private:
-  static bool gt7_names_ok(const std::string& s) {
-    // Mirrors lut/gt7_mapping.h TimeMapping::ParseName (the generator does not link the lut module).
-    const std::string base = s.substr(0, s.find(':'));
-    if (base != "gt7" && base != "gt7-quadratic") return false;
-    if (s.find(':') == std::string::npos) return true;
-    int u = 0, l = 0;
-    char tail = 0;
-    const std::string counts = s.substr(s.find(':') + 1);
-    return std::sscanf(counts.c_str(), "%d+%d%c", &u, &l, &tail) == 2 && u >= 2 && l >= 2 && u + l <= 4096 &&
-           counts == fmt::format("{}+{}", u, l);
-  }
-
   bool enabled_ = false;
   std::string method_ = "orders";
   std::string quality_ = "medium";

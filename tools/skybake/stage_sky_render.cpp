@@ -23,6 +23,7 @@
 #include "atmosphere/spec.h"
 #include "paths.h"
 #include "stage.h"
+#include "stage_helpers.h"
 #include "io/size.h"
 
 namespace skybake {
@@ -87,11 +88,7 @@ class SkyRenderStage : public Stage {
       b.rule = "sky_render";
       b.inputs = {comp_rel.generic_string()};
       b.implicit_inputs = {ctx.ToolPath(tool()), paths::Profiles(a.name).generic_string()};
-      std::set<std::string> particles;
-      for (const AerosolLayerSpec& layer : a.spec.aerosols) {
-        if (layer.particle) particles.insert(layer.particle->stem().string());
-      }
-      for (const std::string& p : particles) b.implicit_inputs.push_back(paths::MieTable(p).generic_string());
+      for (const std::string& mie : MieTableInputs(a.spec)) b.implicit_inputs.push_back(mie);
       std::string args = fmt::format(
           "render --method {} --profiles {} --mie-dir mie --wavelengths {}:{}:{} --mapping {} --size {} "
           "--sun-zenith-deg {} --target-error {}",

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "atmosphere/ray_sphere.h"
 #include "io/error.h"
 
 namespace skybake::fog {
@@ -39,13 +40,8 @@ FogGeometry::FogGeometry(double planet_radius_m, double observer_altitude_m, dou
 double FogGeometry::ClampedMu(double mu) { return std::isfinite(mu) ? std::clamp(mu, 0.0, 1.0) : 0.0; }
 
 double FogGeometry::BoundaryDistanceM(double mu) const {
-  const double m = ClampedMu(mu);
-  const double r = observer_radius_m(), rc = cut_radius_m();
-  // r_c^2 - r^2 = (r_c - r)(r_c + r) without cancellation.
-  const double q = (rc - r) * (rc + r);
-  const double b = r * m;
-  // -b + sqrt(b^2 + q) = q / (b + sqrt(b^2 + q)): no cancellation when b >> q (looking up).
-  return q / (b + std::sqrt(b * b + q));
+  // The far root in its rationalised form: no cancellation looking up (r mu >> r_c - r).
+  return DistanceToSphereOutStable(observer_radius_m(), ClampedMu(mu), cut_radius_m());
 }
 
 double FogGeometry::NormalisedDepth(double depth_m, double mu) const {

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <charconv>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -17,6 +16,7 @@
 #include "color/color.h"
 #include "fog/fog_evaluator.h"
 #include "io/error.h"
+#include "io/exr_attributes.h"
 #include "io/yaml.h"
 #include "transport/path_tracer.h"
 #include "transport/view_segment.h"
@@ -432,31 +432,6 @@ void WriteFogRender(const Scene& scene, const FogRenderOptions& o, const FogRend
 
 // ------------------------------------------------------------------------------------- reading
 
-namespace {
-
-const std::string* StringAttr(const ExrImage& img, const std::string& key) {
-  auto it = img.strings.find(key);
-  return it == img.strings.end() ? nullptr : &it->second;
-}
-const double* DoubleAttr(const ExrImage& img, const std::string& key) {
-  auto it = img.doubles.find(key);
-  return it == img.doubles.end() ? nullptr : &it->second;
-}
-
-// The index NN of "fog.slice_NN.sza_...", or -1.
-int SliceIndex(const std::string& name) {
-  const std::string prefix = "fog.slice_";
-  if (name.rfind(prefix, 0) != 0) return -1;
-  int i = -1;
-  const char* b = name.data() + prefix.size();
-  const char* e = name.data() + name.size();
-  auto res = std::from_chars(b, e, i);
-  if (res.ec != std::errc() || res.ptr == b || res.ptr == e || *res.ptr != '.') return -1;
-  return i;
-}
-
-}  // namespace
-
 FogRender ReadFogRender(const fs::path& path) {
   const std::string name = path.string();
   auto fail = [&](const std::string& msg) { throw InputError(FileLoc{name, 0}, msg); };
@@ -465,12 +440,12 @@ FogRender ReadFogRender(const fs::path& path) {
   r.path = name;
   const ExrImage& sun_img = FindPart(parts, "sun", name);
   auto need_d = [&](const ExrImage& img, const std::string& part, const std::string& key) {
-    const double* v = DoubleAttr(img, key);
+    const double* v = FindDoubleAttribute(img, key);
     if (!v || !std::isfinite(*v)) fail("part '" + part + "' has no " + key + ": not a sky-render fog render");
     return *v;
   };
   auto need_s = [&](const ExrImage& img, const std::string& part, const std::string& key) {
-    const std::string* v = StringAttr(img, key);
+    const std::string* v = FindStringAttribute(img, key);
     if (!v) fail("part '" + part + "' has no " + key + ": not a sky-render fog render");
     return *v;
   };
@@ -486,7 +461,7 @@ FogRender ReadFogRender(const fs::path& path) {
   } catch (const UsageError& e) {
     fail(e.what());
   }
-  if (const std::string* p = StringAttr(sun_img, "skybake.parameters")) {
+  if (const std::string* p = FindStringAttribute(sun_img, "skybake.parameters")) {
     const size_t at = p->find("method: ");
     if (at != std::string::npos) r.method_description = p->substr(at, p->find('\n', at) - at);
   }
@@ -499,8 +474,8 @@ FogRender ReadFogRender(const fs::path& path) {
   const size_t nw = r.wavelength_nm.size();
   auto same_fog = [&](const ExrImage& img, const std::string& part) {
     for (const char* key : {"skybake.fog.planet_radius_m", "skybake.fog.observer_altitude_m", "skybake.fog.cut_altitude_m"}) {
-      const double* v = DoubleAttr(img, key);
-      if (!v || *v != *DoubleAttr(sun_img, key)) fail("part '" + part + "' has another " + std::string(key) + " than part 'sun'");
+      const double* v = FindDoubleAttribute(img, key);
+      if (!v || *v != *FindDoubleAttribute(sun_img, key)) fail("part '" + part + "' has another " + std::string(key) + " than part 'sun'");
     }
   };
   auto finite = [&](const std::vector<float>& v, const std::string& part) {
@@ -513,7 +488,7 @@ FogRender ReadFogRender(const fs::path& path) {
   std::vector<const ExrPart*> slices;
   for (const ExrPart& p : parts) {
     if (p.name.rfind("fog.", 0) != 0) continue;
-    const int index = SliceIndex(p.name);
+    const int index = NumberedPartIndex(p.name, "fog.slice_");
     if (index != static_cast<int>(slices.size())) fail(fmt::format("part '{}' is out of order (expected slice {})", p.name, slices.size()));
     slices.push_back(&p);
   }
@@ -534,7 +509,7 @@ FogRender ReadFogRender(const fs::path& path) {
     fail(fmt::format("{} fog LUT slices, but the time mapping '{}' has {}", slices.size(), r.time_mapping_name, r.time.slices()));
   }
   // The texel grid (centres or nodes) is part of the mapping's description: read it from there.
-  const std::string* first_mapping = StringAttr(first, "skybake.mapping");
+  const std::string* first_mapping = FindStringAttribute(first, "skybake.mapping");
   for (gt7::TexelGrid g : {gt7::TexelGrid::kCentres, gt7::TexelGrid::kNodes}) {
     if (first_mapping && *first_mapping == gt7::Gt7SkyMapping(r.lut_width, r.lut_height, r.sphere, g).Describe()) r.texel_grid = g;
   }
@@ -545,7 +520,7 @@ FogRender ReadFogRender(const fs::path& path) {
     const ExrImage& img = slices[k]->image;
     const std::string& pn = slices[k]->name;
     if (img.width != r.lut_width || img.height != r.lut_height) fail("part '" + pn + "' has another size than the first slice");
-    const std::string* mp = StringAttr(img, "skybake.mapping");
+    const std::string* mp = FindStringAttribute(img, "skybake.mapping");
     if (!mp || *mp != expect_mapping) fail("part '" + pn + "' is not on the GT7 sphere mapping");
     const double sza = need_d(img, pn, "skybake.sun_zenith_deg");
     if (std::fabs(sza - expect_zenith[k]) > 1e-9) {

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "atmosphere/ray_sphere.h"
 #include "io/error.h"
 #include "io/yaml.h"
 
@@ -62,12 +63,9 @@ double TimeMapping::DMaxM() const {
 }
 
 // d(theta) = sqrt(r^2 cos^2 + R^2 - r^2) - r cos; for cos >= 0 the rationalised form
-// (R^2 - r^2) / (sqrt(...) + r cos) avoids the cancellation.
+// (R^2 - r^2) / (sqrt(...) + r cos) avoids the cancellation (atmosphere/ray_sphere.h).
 double TimeMapping::PathToBoundaryM(double zenith_rad) const {
-  const double r = observer_radius_m, c = std::cos(zenith_rad);
-  const double k = (top_radius_m - r) * (top_radius_m + r);
-  const double root = std::sqrt(r * r * c * c + k);
-  return c >= 0.0 ? k / (root + r * c) : root - r * c;
+  return DistanceToSphereOutStableR2Mu2(observer_radius_m, std::cos(zenith_rad), top_radius_m);
 }
 
 double TimeMapping::SliceZenithRad(int i) const {

@@ -66,6 +66,27 @@ std::string TextureTypeProblem(uint32_t w, uint32_t h, uint32_t d, uint32_t face
   return "";
 }
 
+// A sample's qualifiers, sampleLower and sampleUpper (KDF 1.3 §5, basic descriptor block): UNORM 0 .. 2^bits - 1;
+// SFLOAT -1 .. 1 and UFLOAT 0 .. 1 as the floats' bit patterns, with the FLOAT (and SIGNED) qualifier.
+void SetSampleRange(Numeric numeric, int bits, DfdSample* s) {
+  switch (numeric) {
+    case Numeric::kUnorm:
+      s->lower = 0;
+      s->upper = bits >= 32 ? 0xFFFFFFFFu : (1u << bits) - 1u;
+      break;
+    case Numeric::kSfloat:
+      s->channel_type |= df::kQualifierFloat | df::kQualifierSigned;
+      s->lower = FloatBits(-1.0f);
+      s->upper = FloatBits(1.0f);
+      break;
+    case Numeric::kUfloat:
+      s->channel_type |= df::kQualifierFloat;
+      s->lower = FloatBits(0.0f);
+      s->upper = FloatBits(1.0f);
+      break;
+  }
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------- DFDs
@@ -82,22 +103,7 @@ BasicDfd UnpackedDfd(int channels, int bytes_per_channel, Numeric numeric) {
     s.bit_offset = static_cast<uint16_t>(8 * bytes_per_channel * c);
     s.bit_length = static_cast<uint8_t>(bits);
     s.channel_type = kIds[c];
-    switch (numeric) {
-      case Numeric::kUnorm:
-        s.lower = 0;
-        s.upper = bits >= 32 ? 0xFFFFFFFFu : (1u << bits) - 1u;
-        break;
-      case Numeric::kSfloat:
-        s.channel_type |= df::kQualifierFloat | df::kQualifierSigned;
-        s.lower = FloatBits(-1.0f);
-        s.upper = FloatBits(1.0f);
-        break;
-      case Numeric::kUfloat:
-        s.channel_type |= df::kQualifierFloat;
-        s.lower = FloatBits(0.0f);
-        s.upper = FloatBits(1.0f);
-        break;
-    }
+    SetSampleRange(numeric, bits, &s);
     dfd.samples.push_back(s);
   }
   return dfd;
@@ -113,22 +119,7 @@ BasicDfd PackedDfd(const std::vector<PackedChannel>& channels, Numeric numeric) 
     s.bit_offset = static_cast<uint16_t>(offset);
     s.bit_length = static_cast<uint8_t>(ch.bits);
     s.channel_type = ch.channel_id;
-    switch (numeric) {
-      case Numeric::kUnorm:
-        s.lower = 0;
-        s.upper = ch.bits >= 32 ? 0xFFFFFFFFu : (1u << ch.bits) - 1u;
-        break;
-      case Numeric::kSfloat:
-        s.channel_type |= df::kQualifierFloat | df::kQualifierSigned;
-        s.lower = FloatBits(-1.0f);
-        s.upper = FloatBits(1.0f);
-        break;
-      case Numeric::kUfloat:
-        s.channel_type |= df::kQualifierFloat;
-        s.lower = FloatBits(0.0f);
-        s.upper = FloatBits(1.0f);
-        break;
-    }
+    SetSampleRange(numeric, ch.bits, &s);
     dfd.samples.push_back(s);
     offset += ch.bits;
   }

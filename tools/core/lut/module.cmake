@@ -1,1 +1,1 @@
-skybake_add_core_module(NAME lut DEPS skybake_color skybake_spectrum skybake_io TBB::tbb)
+skybake_add_core_module(NAME lut DEPS skybake_atmosphere skybake_color skybake_spectrum skybake_io TBB::tbb)

@@ -1,7 +1,6 @@
 #include "lut/sky_lut.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <numbers>
 
@@ -9,6 +8,7 @@
 
 #include "io/error.h"
 #include "io/exr.h"
+#include "io/exr_attributes.h"
 #include "io/yaml.h"
 #include "lut/r11g11b10.h"
 #include "spectrum/cmf.h"
@@ -29,30 +29,9 @@ std::string Join(const std::vector<double>& v) {
   return s;
 }
 
-const std::string* StringAttr(const ExrImage& img, const std::string& key) {
-  auto it = img.strings.find(key);
-  return it == img.strings.end() ? nullptr : &it->second;
-}
-const double* DoubleAttr(const ExrImage& img, const std::string& key) {
-  auto it = img.doubles.find(key);
-  return it == img.doubles.end() ? nullptr : &it->second;
-}
-
-// The index NN of a part named "sky.slice_NN.sza_DDD.DD" (sky_scene.cpp WriteRender), or -1.
-int SliceIndexOfPartName(const std::string& name) {
-  const std::string prefix = "sky.slice_";
-  if (name.rfind(prefix, 0) != 0) return -1;
-  int i = -1;
-  const char* b = name.data() + prefix.size();
-  const char* e = name.data() + name.size();
-  auto r = std::from_chars(b, e, i);
-  if (r.ec != std::errc() || r.ptr == b || r.ptr == e || *r.ptr != '.') return -1;
-  return i;
-}
-
 // The `method: ...` line of the render's resolved parameters (provenance), for the report.
 std::string MethodOf(const ExrImage& img) {
-  const std::string* p = StringAttr(img, "skybake.parameters");
+  const std::string* p = FindStringAttribute(img, "skybake.parameters");
   if (!p) return "";
   const size_t at = p->find("method: ");
   if (at == std::string::npos) return "";
@@ -73,7 +52,7 @@ SkyRender ReadSkyRender(const fs::path& path) {
   std::vector<const ExrPart*> slices;
   for (const ExrPart& p : parts) {
     if (p.name.rfind("sky.", 0) != 0) continue;
-    const int index = SliceIndexOfPartName(p.name);
+    const int index = NumberedPartIndex(p.name, "sky.slice_");
     if (index < 0) {
       fail("part '" + p.name + "' is not a slice of the GT7 time mapping: render with sky-render render --mapping gt7 "
            "--time-mapping gt7");
@@ -86,9 +65,9 @@ SkyRender ReadSkyRender(const fs::path& path) {
   const ExrImage& first = slices[0]->image;
   r.width = first.width;
   r.height = first.height;
-  const std::string* tm_name = StringAttr(first, "skybake.time_mapping");
-  const double* obs_r = DoubleAttr(first, "skybake.time_mapping.observer_radius_m");
-  const double* top_r = DoubleAttr(first, "skybake.time_mapping.top_radius_m");
+  const std::string* tm_name = FindStringAttribute(first, "skybake.time_mapping");
+  const double* obs_r = FindDoubleAttribute(first, "skybake.time_mapping.observer_radius_m");
+  const double* top_r = FindDoubleAttribute(first, "skybake.time_mapping.top_radius_m");
   if (!tm_name || !obs_r || !top_r) fail("part '" + slices[0]->name + "' has no skybake.time_mapping attributes: render with --time-mapping gt7");
   const std::optional<gt7::TimeMappingKind> n = gt7::TimeMapping::ParseName(*tm_name);
   if (!n) fail("unknown time mapping '" + *tm_name + "'");
@@ -110,18 +89,18 @@ SkyRender ReadSkyRender(const fs::path& path) {
     if (img.width != r.width || img.height != r.height) {
       fail(fmt::format("part '{}' is {}x{}, the first slice {}x{}", pn, img.width, img.height, r.width, r.height));
     }
-    const std::string* mapping = StringAttr(img, "skybake.mapping");
+    const std::string* mapping = FindStringAttribute(img, "skybake.mapping");
     if (!mapping || *mapping != expect_mapping) {
       fail("part '" + pn + "' was not rendered on lut-pack's GT7 sphere mapping (render with --mapping gt7): " +
            (mapping ? "'" + mapping->substr(0, 60) + "...'" : std::string("no skybake.mapping")));
     }
-    const std::string* tn = StringAttr(img, "skybake.time_mapping");
-    const double* o2 = DoubleAttr(img, "skybake.time_mapping.observer_radius_m");
-    const double* t2 = DoubleAttr(img, "skybake.time_mapping.top_radius_m");
+    const std::string* tn = FindStringAttribute(img, "skybake.time_mapping");
+    const double* o2 = FindDoubleAttribute(img, "skybake.time_mapping.observer_radius_m");
+    const double* t2 = FindDoubleAttribute(img, "skybake.time_mapping.top_radius_m");
     if (!tn || *tn != *tm_name || !o2 || *o2 != *obs_r || !t2 || *t2 != *top_r) {
       fail("part '" + pn + "' has another time mapping than the first slice");
     }
-    const double* sza = DoubleAttr(img, "skybake.sun_zenith_deg");
+    const double* sza = FindDoubleAttribute(img, "skybake.sun_zenith_deg");
     if (!sza || std::fabs(*sza - expect_zenith[k]) > 1e-9) {
       fail(fmt::format("part '{}': sun zenith {} deg, but slice {} of the time mapping is at {} deg", pn,
                        sza ? FormatExact(*sza) : std::string("(none)"), k, FormatExact(expect_zenith[k])));
@@ -142,7 +121,7 @@ SkyRender ReadSkyRender(const fs::path& path) {
       }
     }
     r.slice_xyz.push_back(std::move(xyz));
-    const std::string* obs = StringAttr(img, "skybake.observer");
+    const std::string* obs = FindStringAttribute(img, "skybake.observer");
     if (!obs) fail("part '" + pn + "' has no skybake.observer");
     if (k == 0) r.observer = *obs;
     else if (*obs != r.observer) fail("part '" + pn + "' has another observer than the first slice");

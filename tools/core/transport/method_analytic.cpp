@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
+#include "atmosphere/ray_sphere.h"
 #include "io/error.h"
 #include "transport/method_single.h"
 #include "transport/path_tracer.h"
@@ -36,9 +37,7 @@ AnalyticSky::AnalyticSky(const AtmosphereModel& m) : model_(m) {
 }
 
 double AnalyticSky::DistanceToTop(const glm::dvec3& p, const glm::dvec3& w) const {
-  const double a0 = model_.top_radius_m * model_.top_radius_m - glm::dot(p, p);
-  const double a1 = glm::dot(p, w);
-  return std::sqrt(std::max(0.0, a1 * a1 + a0)) - a1;
+  return DistanceToSphereOutDot(glm::dot(p, w), glm::dot(p, p), model_.top_radius_m);
 }
 
 void AnalyticSky::Radiance(const glm::dvec3& x, const glm::dvec3& v, const glm::dvec3& sun, int steps, double* L) const {

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
+#include "atmosphere/ray_sphere.h"
 #include "io/error.h"
 #include "transport/path_tracer.h"
 
@@ -69,7 +70,7 @@ void ExactOpticalDepth(const LevelTables& t, double r0, double mu, double length
   const AtmosphereModel& m = t.model;
   const double R = m.bottom_radius_m, R_top = m.top_radius_m;
   const size_t nw = t.nw;
-  const double p2 = std::max(0.0, r0 * r0 * (1.0 - mu * mu));
+  const double p2 = ImpactParameterSquared(r0, mu);
   const double s0 = r0 * mu, s1 = s0 + length;
   // One monotone part: s in [a, b], 0 <= a < b, r(s) = sqrt(p2 + s^2) increasing.
   auto part = [&](double a, double b) {
@@ -120,7 +121,7 @@ TransmittanceTable::TransmittanceTable(const LevelTables& t, int n_mu, int n_r)
     : t_(t), n_mu_(n_mu), n_r_(n_r), R_(t.model.bottom_radius_m), R_top_(t.model.top_radius_m) {
   SKYBAKE_CHECK_GE(n_mu, 2);
   SKYBAKE_CHECK_GE(n_r, 2);
-  H_ = std::sqrt(R_top_ * R_top_ - R_ * R_);
+  H_ = DistanceToHorizon(R_top_, R_);
   const size_t nw = t.nw;
   tau_.assign(static_cast<size_t>(n_mu) * n_r * nw, 0.0);
   tbb::parallel_for(tbb::blocked_range<int>(0, n_r), [&](const tbb::blocked_range<int>& rows) {
@@ -138,13 +139,13 @@ TransmittanceTable::TransmittanceTable(const LevelTables& t, int n_mu, int n_r)
 }
 
 double TransmittanceTable::HorizonMu(double r) const {
-  return -std::sqrt(std::max(0.0, 1.0 - (R_ * R_) / (r * r)));
+  return HorizonMuOfSquares(r, R_);
 }
 
 void TransmittanceTable::OpticalDepth(double r, double mu, double* tau) const {
   r = std::clamp(r, R_, R_top_);
-  const double rho = std::sqrt(std::max(0.0, r * r - R_ * R_));
-  const double d = std::max(0.0, -r * mu + std::sqrt(std::max(0.0, r * r * (mu * mu - 1.0) + R_top_ * R_top_)));
+  const double rho = DistanceToHorizon(r, R_);
+  const double d = DistanceToTopAtmosphereBoundary(r, mu, R_top_);
   const double d_min = R_top_ - r, d_max = rho + H_;
   const double x_mu = std::clamp((d - d_min) / (d_max - d_min), 0.0, 1.0);
   const double x_r = std::clamp(rho / H_, 0.0, 1.0);
@@ -206,16 +207,15 @@ RayExtent ExtentOf(const AtmosphereModel& m, const glm::dvec3& x, const glm::dve
   RayExtent e;
   const double b = glm::dot(x, v), r2 = glm::dot(x, x);
   const double R = m.bottom_radius_m;
-  const double dg = b * b - (r2 - R * R);
-  if (b < 0.0 && dg >= 0.0) {
-    const double t0 = -b - std::sqrt(dg);
+  if (b < 0.0 && SphereDiscriminantDot(b, r2, R) >= 0.0) {
+    const double t0 = DistanceToSphereInDot(b, r2, R);
     if (t0 >= -1e-9 * R) {
       e.hits_ground = true;
       e.ground = std::max(0.0, t0);
     }
   }
-  const double dt = b * b - (r2 - m.top_radius_m * m.top_radius_m);
-  e.top = dt >= 0.0 ? std::max(0.0, -b + std::sqrt(dt)) : 0.0;
+  // A ray from outside the atmosphere that misses it has no length (the far root alone would be -b).
+  e.top = SphereDiscriminantDot(b, r2, m.top_radius_m) >= 0.0 ? ClampDistance(DistanceToSphereOutDot(b, r2, m.top_radius_m)) : 0.0;
   return e;
 }
 
@@ -251,7 +251,7 @@ std::vector<double> SingleScatteringModel::Nodes(const glm::dvec3& x, const glm:
   std::vector<double> t = {0.0, length};
   const double r0 = glm::length(x);
   const double mu = glm::dot(x, v) / r0;
-  const double p2 = std::max(0.0, r0 * r0 * (1.0 - mu * mu));
+  const double p2 = ImpactParameterSquared(r0, mu);
   const double s0 = r0 * mu;
   auto add = [&](double tt) {
     if (tt > 0.0 && tt < length) t.push_back(tt);

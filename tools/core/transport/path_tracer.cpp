@@ -7,6 +7,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "atmosphere/ray_sphere.h"
 #include "io/error.h"
 
 namespace skybake {
@@ -33,21 +34,15 @@ struct SphereHit {
 };
 
 SphereHit NearSphere(const glm::dvec3& p, const glm::dvec3& d, double radius) {
-  const double b = glm::dot(p, d);
-  const double c = glm::dot(p, p) - radius * radius;
-  const double disc = b * b - c;
-  if (disc < 0.0) return {0.0, false};
-  const double s = std::sqrt(disc);
-  const double t0 = -b - s;
+  const double b = glm::dot(p, d), r2 = glm::dot(p, p);
+  if (SphereDiscriminantDot(b, r2, radius) < 0.0) return {0.0, false};
+  const double t0 = DistanceToSphereInDot(b, r2, radius);
   if (t0 > 0.0) return {t0, true};
   return {0.0, false};
 }
 
 double FarSphere(const glm::dvec3& p, const glm::dvec3& d, double radius) {
-  const double b = glm::dot(p, d);
-  const double c = glm::dot(p, p) - radius * radius;
-  const double disc = std::max(0.0, b * b - c);
-  return -b + std::sqrt(disc);
+  return DistanceToSphereOutDot(glm::dot(p, d), glm::dot(p, p), radius);
 }
 
 glm::dvec3 CosineHemisphere(const glm::dvec3& n, double u1, double u2) {
@@ -223,7 +218,7 @@ void PathTracer::SegmentSunNee(const glm::dvec3& p, const glm::dvec3& d, const d
   // distance of x from the shadow axis is below the planet radius, shrunk by the penumbra
   // (angular radius x the longest sunlit chord through the atmosphere) so that points lit by
   // part of the disk are kept (the estimator stays unbiased; NEE then finds the exact visibility).
-  const double margin = model_.sun.angular_radius_rad * std::sqrt(top * top - R * R) + 1.0;
+  const double margin = model_.sun.angular_radius_rad * DistanceToHorizon(top, R) + 1.0;
   const double rs = R - margin;
   const double ps = glm::dot(p, sun), ds = glm::dot(d, sun);
   auto lit = [&](double t) {

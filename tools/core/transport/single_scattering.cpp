@@ -7,6 +7,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "atmosphere/ray_sphere.h"
 #include "transport/path_tracer.h"
 
 namespace skybake {
@@ -21,13 +22,11 @@ void RayExtent(const AtmosphereModel& m, const glm::dvec3& x, const glm::dvec3& 
   const double b = glm::dot(x, d);
   const double r2 = glm::dot(x, x);
   *t_ground = std::numeric_limits<double>::infinity();
-  const double dg = b * b - (r2 - m.bottom_radius_m * m.bottom_radius_m);
-  if (dg >= 0.0) {
-    const double t0 = -b - std::sqrt(dg);
+  if (SphereDiscriminantDot(b, r2, m.bottom_radius_m) >= 0.0) {
+    const double t0 = DistanceToSphereInDot(b, r2, m.bottom_radius_m);
     if (t0 > 0.0) *t_ground = t0;
   }
-  const double dt = std::max(0.0, b * b - (r2 - m.top_radius_m * m.top_radius_m));
-  *t_top = std::max(0.0, -b + std::sqrt(dt));
+  *t_top = ClampDistance(DistanceToSphereOutDot(b, r2, m.top_radius_m));
 }
 }  // namespace
 

@@ -1,5 +1,6 @@
 #include "transport/sky_render.h"
 
+#include "atmosphere/ray_sphere.h"
 #include "transport/ambient.h"
 
 #include <tbb/blocked_range.h>
@@ -34,13 +35,12 @@ void TransmittanceToSpace(const AtmosphereModel& m, double altitude_m, double ze
   const double r0 = m.bottom_radius_m + altitude_m;
   const double mu = std::cos(zenith_rad);
   // Ray-sphere geometry from r0 along mu: r(t)^2 = r0^2 + 2 r0 mu t + t^2.
-  const double b = r0 * mu;
-  const double disc_ground = b * b - (r0 * r0 - m.bottom_radius_m * m.bottom_radius_m);
-  if (mu < 0.0 && disc_ground >= 0.0) {
-    const double t_ground = -b - std::sqrt(disc_ground);
+  const double b = r0 * mu, r2 = r0 * r0;
+  if (mu < 0.0 && SphereDiscriminantDot(b, r2, m.bottom_radius_m) >= 0.0) {
+    const double t_ground = DistanceToSphereInDot(b, r2, m.bottom_radius_m);
     if (t_ground >= 0.0) return;
   }
-  const double length = -b + std::sqrt(std::max(0.0, b * b - (r0 * r0 - m.top_radius_m * m.top_radius_m)));
+  const double length = DistanceToSphereOutDot(b, r2, m.top_radius_m);
   // Composite 4-point Gauss-Legendre on pieces of <= 100 m (the profile's level spacing is
   // 100 m by default; the integrand is smooth within a level and the rule is exact to ~1e-7).
   static const double kX[2] = {0.3399810435848563, 0.8611363115940526};
@@ -57,7 +57,7 @@ void TransmittanceToSpace(const AtmosphereModel& m, double altitude_m, double ze
       const double wk = kW[k] * 0.5 * h;
       for (double sgn : {-1.0, 1.0}) {
         const double t = c + sgn * 0.5 * h * kX[k];
-        const double r = std::sqrt(r0 * r0 + 2.0 * r0 * mu * t + t * t);
+        const double r = RadiusAt(r0, mu, t);
         const AtmosphereModel::Cell cell = m.Locate(r - m.bottom_radius_m);
         m.Extinction(cell, w0, nw, ext.data());
         for (size_t w = 0; w < nw; ++w) tau[w] += wk * ext[w];

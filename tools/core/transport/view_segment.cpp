@@ -5,20 +5,10 @@
 
 #include <fmt/format.h>
 
+#include "atmosphere/ray_sphere.h"
 #include "io/error.h"
 
 namespace skybake {
-
-namespace {
-
-// Distance along a ray from radius r with zenith cosine mu to the sphere of radius rho, going
-// outward (far root); r <= rho.
-double ExitDistance(double r, double mu, double rho) {
-  const double disc = std::max(0.0, r * r * (mu * mu - 1.0) + rho * rho);
-  return -r * mu + std::sqrt(disc);
-}
-
-}  // namespace
 
 double SegmentEnd(const AtmosphereModel& model, double observer_altitude_m, double mu, const ViewSegment& segment) {
   const double R = model.bottom_radius_m;
@@ -30,9 +20,8 @@ double SegmentEnd(const AtmosphereModel& model, double observer_altitude_m, doub
   if (!(segment.max_distance_m >= 0.0)) throw UsageError("a view segment's distance must be >= 0");
   const double r = R + std::max(0.0, observer_altitude_m);
   mu = std::clamp(mu, -1.0, 1.0);
-  double t = ExitDistance(r, mu, R + cut);
-  const double disc_g = r * r * (mu * mu - 1.0) + R * R;
-  if (mu < 0.0 && disc_g >= 0.0) t = std::min(t, -r * mu - std::sqrt(disc_g));
+  double t = DistanceToSphereOut(r, mu, R + cut);
+  if (RayIntersectsGround(r, mu, R)) t = std::min(t, DistanceToSphereIn(r, mu, R));
   return std::max(0.0, std::min(t, segment.max_distance_m));
 }
 
@@ -46,7 +35,7 @@ void SegmentTransmittance(const AtmosphereModel& model, double observer_altitude
   }
   const double R = model.bottom_radius_m;
   const double r = R + std::max(0.0, observer_altitude_m);
-  auto altitude = [&](double s) { return std::sqrt(r * r + 2.0 * r * mu * s + s * s) - R; };
+  auto altitude = [&](double s) { return RadiusAt(r, mu, s) - R; };
   // Pieces: the altitude changes by at most 50 m + 5 % of the altitude across one, and none is
   // longer than 20 km; 4-point Gauss-Legendre on each.
   static const double kX[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526};
@@ -58,7 +47,7 @@ void SegmentTransmittance(const AtmosphereModel& model, double observer_altitude
     const double dz_max = 50.0 + 0.05 * z;
     // Local slope of the altitude, |dz/ds| <= 1; curvature adds at most s^2 / (2 R).
     const double rr = R + z;
-    const double slope = std::abs((r * mu + s0) / rr);
+    const double slope = std::abs(MuAt(r, mu, s0, rr));
     double h = std::min(20e3, t - s0);
     if (slope * h > dz_max) h = dz_max / slope;
     h = std::max(h, std::min(1.0, t - s0));

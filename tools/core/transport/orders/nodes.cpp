@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "atmosphere/model.h"
+#include "atmosphere/ray_sphere.h"
 
 namespace skybake::orders {
 
@@ -35,10 +36,7 @@ Nodes BuildNodes(const AtmosphereModel& m, const OrdersSettings& s, double obser
   return n;
 }
 
-double Nodes::HorizonMu(double r) const {
-  const double q = bottom_radius_m / r;
-  return -std::sqrt(std::max(0.0, 1.0 - q * q));
-}
+double Nodes::HorizonMu(double r) const { return skybake::HorizonMu(r, bottom_radius_m); }
 
 // View nodes, in ascending mu, placed in the view zenith angle theta (theta_h the horizon's,
 // > 90 deg): k < ndn below the horizon, theta = theta_h + (pi - theta_h)(1 - s)^p, s = k/(ndn-1),

@@ -5,6 +5,8 @@
 
 #include <cmath>
 
+#include "atmosphere/ray_sphere.h"
+
 namespace skybake::orders {
 
 namespace {
@@ -54,7 +56,7 @@ FineDepth FineDepthAlong(const AtmosphereModel& m, const Medium& md, const Order
   const size_t wref = nw / 2;
   for (int p = 0; p < nf; ++p) {
     const double tm = (p + 0.5) * d / nf;
-    const double rr = std::sqrt(r * r + 2.0 * r * mu * tm + tm * tm);
+    const double rr = RadiusAt(r, mu, tm);
     md.SigmaT(rr - R, true, st->data());
     fd.cum[static_cast<size_t>(p) + 1] = fd.cum[static_cast<size_t>(p)] + (*st)[wref] * d / nf;
     for (size_t w = 0; w < nw; ++w) {
@@ -106,9 +108,9 @@ void AddStep(const AtmosphereModel& m, const Medium& md, const Nodes& nodes, con
   const double h = t1 - t0;
   const double tm = StepPoint(fd, t0, t1, wref);
   f->t.push_back(tm);
-  const double rr = std::sqrt(r * r + 2.0 * r * mu * tm + tm * tm);
+  const double rr = RadiusAt(r, mu, tm);
   f->r.push_back(rr);
-  f->mu.push_back((r * mu + tm) / rr);
+  f->mu.push_back(MuAt(r, mu, tm, rr));
   f->rv.push_back(nodes.RadialViewAt(rr, f->mu.back()));
   const AtmosphereModel::Cell cell = m.Locate(rr - R);  // one lookup for the step's media
   for (size_t c = 0; c < md.nc; ++c) {
@@ -132,9 +134,8 @@ void BuildFamily(const AtmosphereModel& m, const Medium& md, const Nodes& nodes,
   const size_t nw = md.nw, nt = static_cast<size_t>(s.nt), nr = nodes.radius.size();
   const double R = m.bottom_radius_m, top = m.top_radius_m;
   const double r = nodes.radius[ri], mu = nodes.ViewMu(k, r);
-  const double disc_g = r * r * (mu * mu - 1.0) + R * R;
-  f->ground = mu < 0.0 && disc_g >= 0.0;
-  f->d = f->ground ? -r * mu - std::sqrt(std::max(0.0, disc_g)) : -r * mu + std::sqrt(std::max(0.0, r * r * (mu * mu - 1.0) + top * top));
+  f->ground = RayIntersectsGround(r, mu, R);
+  f->d = DistanceToNearestBoundary(r, mu, R, top, f->ground);
   if (f->d <= 0.0) {  // on the ground looking down: nothing but the ground
     f->d = 0.0;
     f->trans_end.assign(nw, 1.0f);
@@ -175,7 +176,7 @@ std::vector<Family> BuildFamilies(const AtmosphereModel& m, const Medium& md, co
 }
 
 SunAzimuth StepSunAzimuth(const Nodes& nodes, bool even, const Family& f, size_t m, double r, double ts, double nu) {
-  const double mus = std::clamp((r * std::cos(ts) + f.t[m] * nu) / f.r[m], -1.0, 1.0);
+  const double mus = ClampCosine(SunMuAt(r, std::cos(ts), nu, f.t[m], f.r[m]));
   const double mu2 = f.mu[m];
   const double denom = std::sqrt(std::max(1e-12, (1.0 - mu2 * mu2) * (1.0 - mus * mus)));
   return nodes.SunAzimuthAt(std::acos(mus), (nu - mu2 * mus) / denom, even);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "atmosphere/ray_sphere.h"
 #include "io/fast_exp.h"
 
 namespace skybake::orders {
@@ -21,7 +22,7 @@ class ViewStepper {
     const size_t wref = md.nw / 2;
     for (int p = 0; p < nf; ++p) {
       const double tm = (p + 0.5) * length / nf;
-      const double rr = std::sqrt(r * r + 2.0 * r * mu * tm + tm * tm);
+      const double rr = RadiusAt(r, mu, tm);
       cum[static_cast<size_t>(p) + 1] = cum[static_cast<size_t>(p)] + md.SigmaTAt(rr - R, false, wref) * length / nf;
     }
     const double tau_tot = std::max(cum.back(), 1e-12);
@@ -66,14 +67,13 @@ void BuildViewRay(const RenderInputs& in, double observer_altitude_m, double r, 
   ray->pts.reserve(npts);
   ray->e.reserve(npts * nc * nw);
   if (segment != nullptr) ray->seg.reserve(npts * nw);
-  const double disc_g = r * r * (mu * mu - 1.0) + R * R;
+  const bool hits_ground = RayIntersectsGround(r, mu, R);
   // Segments never include the ground surface (transport/view_segment.h).
-  ray->ground = segment == nullptr && mu < 0.0 && disc_g >= 0.0;
+  ray->ground = segment == nullptr && hits_ground;
   if (segment != nullptr) {
     ray->length = SegmentEnd(m, observer_altitude_m, mu, *segment);
   } else {
-    ray->length = mu < 0.0 && disc_g >= 0.0 ? -r * mu - std::sqrt(std::max(0.0, disc_g))
-                                            : -r * mu + std::sqrt(std::max(0.0, r * r * (mu * mu - 1.0) + top * top));
+    ray->length = DistanceToNearestBoundary(r, mu, R, top, hits_ground);
   }
   const double length = ray->length;
   std::vector<double> tau(nw, 0.0), tau_star(nw, 0.0);
@@ -89,10 +89,10 @@ void BuildViewRay(const RenderInputs& in, double observer_altitude_m, double r, 
     const double h = t1 - t0;
     for (double g : {-kG, kG}) {
       const double t = 0.5 * (t0 + t1) + 0.5 * g * h;
-      const double rr = std::sqrt(r * r + 2.0 * r * mu * t + t * t);
+      const double rr = RadiusAt(r, mu, t);
       // Optical depth from the observer to t: advance from t_prev with the midpoint value.
       const double tmid = 0.5 * (t_prev + t);
-      const double rmid = std::sqrt(r * r + 2.0 * r * mu * tmid + tmid * tmid);
+      const double rmid = RadiusAt(r, mu, tmid);
       const AtmosphereModel::Cell cmid = m.Locate(rmid - R), cell = m.Locate(rr - R);
       md.SigmaTView(cmid, st.data());
       for (size_t w = 0; w < nw; ++w) tau[w] += st[w] * (t - t_prev);
@@ -101,7 +101,7 @@ void BuildViewRay(const RenderInputs& in, double observer_altitude_m, double r, 
         for (size_t w = 0; w < nw; ++w) tau_star[w] += st[w] * (t - t_prev);
       }
       t_prev = t;
-      ray->pts.push_back({t, rr, std::clamp((r * mu + t) / rr, -1.0, 1.0), in.sun->Radius(rr, in.ss_scaled)});
+      ray->pts.push_back({t, rr, ClampCosine(MuAt(r, mu, t, rr)), in.sun->Radius(rr, in.ss_scaled)});
       const float hw = static_cast<float>(segment == nullptr || segment->single_scattering ? 0.5 * h : 0.0);
       const size_t e0 = ray->e.size();
       ray->e.resize(e0 + nc * nw);
@@ -126,7 +126,7 @@ void BuildViewRay(const RenderInputs& in, double observer_altitude_m, double r, 
   if (ray->ground) {
     // Finish the optical depth to the ground.
     const double tmid = 0.5 * (t_prev + length);
-    const double rmid = std::sqrt(r * r + 2.0 * r * mu * tmid + tmid * tmid);
+    const double rmid = RadiusAt(r, mu, tmid);
     md.SigmaTView(m.Locate(rmid - R), st.data());
     for (size_t w = 0; w < nw; ++w) ray->t_end[w] = static_cast<float>(std::exp(-(tau[w] + st[w] * (length - t_prev))));
   }
@@ -196,7 +196,7 @@ void MarchViewRay(const RenderInputs& in, const ViewRay& ray, double r, double t
   std::fill(x->seg_ms.begin(), x->seg_ms.end(), 0.0);
   for (size_t p = 0; p < ray.pts.size(); ++p) {
     const ViewPoint& pt = ray.pts[p];
-    const double mus = (r * std::cos(ts) + pt.t * nu) / pt.rr;
+    const double mus = SunMuAt(r, std::cos(ts), nu, pt.t, pt.rr);
     if (segment == nullptr || segment->single_scattering) {
       in.sun->TransmittanceAt(pt.sun_r, mus, in.ss_scaled, x->tsun.data());
       const float* e = &ray.e[p * nc * nw];
@@ -214,7 +214,7 @@ void MarchViewRay(const RenderInputs& in, const ViewRay& ray, double r, double t
   }
   if (ray.ground) {
     const double R = in.m->bottom_radius_m;
-    const double mus_g = (r * std::cos(ts) + std::max(0.0, ray.length) * nu) / R;
+    const double mus_g = SunMuAt(r, std::cos(ts), nu, std::max(0.0, ray.length), R);
     if (mus_g > -0.5) {
       in.sun->Transmittance(R, mus_g, in.ss_scaled, x->tsun.data());
       for (size_t w = 0; w < nw; ++w) {

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 
+#include "atmosphere/ray_sphere.h"
 #include "io/fast_exp.h"
 
 namespace skybake::orders {
@@ -22,16 +23,15 @@ bool RayDepth(const AtmosphereModel& m, const Medium& md, int pieces, double r, 
   const double R = m.bottom_radius_m, top = m.top_radius_m;
   tau->assign(nw, 0.0);
   tau_f->assign(nw, 0.0);
-  const double disc_g = r * r * (mu * mu - 1.0) + R * R;
-  if (mu < 0.0 && disc_g >= 0.0) return false;  // hits the ground
-  const double length = -r * mu + std::sqrt(std::max(0.0, r * r * (mu * mu - 1.0) + top * top));
+  if (RayIntersectsGround(r, mu, R)) return false;
+  const double length = DistanceToSphereOut(r, mu, top);
   const double h = length / pieces;
   static const double kG = 0.5773502691896257;
   std::vector<float> st(nw), sts(nw);
   for (int p = 0; p < pieces; ++p) {
     for (double g : {-kG, kG}) {
       const double t = (p + 0.5 + 0.5 * g) * h;
-      const double rr = std::sqrt(r * r + 2.0 * r * mu * t + t * t);
+      const double rr = RadiusAt(r, mu, t);
       const AtmosphereModel::Cell cell = m.Locate(rr - R);  // one lookup for both media
       md.SigmaT(cell, false, st.data());
       md.SigmaT(cell, true, sts.data());

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "atmosphere/ray_sphere.h"
 #include "transport/orders/simd.h"
 
 namespace skybake::orders {
@@ -91,8 +92,8 @@ std::vector<float> LogLinFactors(const TransportContext& tc, const Table& Jin) {
 
 void AddGroundReflection(const Nodes& nodes, const Medium& md, const Family& f, double r, double ts, double nu,
                          const std::vector<float>& E, float* eg, float* acc) {
-  const double mus_g = (r * std::cos(ts) + f.d * nu) / nodes.bottom_radius_m;
-  InterpE(nodes, E, std::acos(std::clamp(mus_g, -1.0, 1.0)), eg);
+  const double mus_g = SunMuAt(r, std::cos(ts), nu, f.d, nodes.bottom_radius_m);
+  InterpE(nodes, E, std::acos(ClampCosine(mus_g)), eg);
   for (size_t w = 0; w < md.nw; ++w) acc[w] += f.trans_end[w] * static_cast<float>(md.albedo[w] / kPi) * eg[w];
 }
 
