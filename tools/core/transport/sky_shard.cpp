@@ -105,7 +105,9 @@ ExrImage JoinSliceTable(const std::vector<std::pair<const Shard*, size_t>>& rows
   const ExrImage& src = *rows.front().first->tables.at(name);
   for (const auto& [k, v] : src.strings) img.strings.emplace(k, v);
   for (const auto& [k, v] : src.doubles) img.doubles.emplace(k, v);
-  for (const auto& [k, v] : src.ints) img.ints.emplace(k, v);
+  for (const auto& [k, v] : src.ints) {
+    if (k != "chunkCount") img.ints.emplace(k, v);  // OpenEXR's, of the shard's fewer rows
+  }
   for (const auto& [k, v] : src.float_vectors) img.float_vectors.emplace(k, v);
   img.chromaticities = src.chromaticities;
   return img;
