@@ -121,6 +121,7 @@ class ShardedGraphTest(ReducedPipeline):
     def generate_fails(self, message):
         r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)
         self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
+        self.assertTrue(r.stderr.startswith("skybake: "), r.stderr)
         self.assertIn(message, r.stderr)
         self.assertFalse(os.path.exists(self.path("outputs", "build.ninja")))
 
@@ -128,17 +129,17 @@ class ShardedGraphTest(ReducedPipeline):
         self.pipeline("pipeline.yaml", "outputs", 0)
         self.generate_fails("pipeline.yaml:7: key 'sky.shards': expected a whole number of shards from 1 to 4096, got \"0\"")
         self.pipeline("pipeline.yaml", "outputs", 6)  # 5 slices of gt7:3+2
-        self.generate_fails("pipeline.yaml:14: shards: 6 shards for the 5 slices of time mapping gt7:3+2: at most one shard "
+        self.generate_fails("pipeline.yaml:14: key 'luts.skies[0]': 6 shards for the 5 slices of time mapping gt7:3+2: at most one shard "
                             "per slice")
         self.pipeline("pipeline.yaml", "outputs", 1)
         self.edit("pipeline.yaml", "preview: true, shards: 1", "preview: true, shards: 9")  # 2 slices x 4 texel tasks
-        self.generate_fails("pipeline.yaml:7: 9 shards for 8 texel tasks of the render: at most one shard per task")
+        self.generate_fails("pipeline.yaml:7: key 'sky.shards': 9 shards for 8 texel tasks of the render: at most one shard per task")
 
     def test_a_missing_launcher_fails_at_generate_time(self):
         self.pipeline("pipeline.yaml", "outputs", 2, 'launchers: {sky-render: "no-such-srun --quiet -n1"}\n')
-        self.generate_fails("skybake: pipeline.yaml:7: launchers.sky-render: 'no-such-srun' is not on PATH")
+        self.generate_fails("pipeline.yaml:7: key 'launchers.sky-render': 'no-such-srun' is not on PATH")
         self.pipeline("pipeline.yaml", "outputs", 2, 'launchers: {sky-render: "./bin/srun -n1"}\n')
-        self.generate_fails("skybake: pipeline.yaml:7: launchers.sky-render: './bin/srun' is not an executable file")
+        self.generate_fails("pipeline.yaml:7: key 'launchers.sky-render': './bin/srun' is not an executable file")
 
 
 def slurm_missing():

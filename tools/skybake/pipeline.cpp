@@ -96,7 +96,7 @@ Pipeline LoadPipeline(const fs::path& path, const std::vector<Stage*>& stages) {
       p.launchers[tool] = launchers->String(tool, "a command prefix");
       // A missing launcher fails here, not when ninja first runs the tool mid-bake.
       if (std::optional<std::string> missing = MissingLauncher(p.launchers[tool], p.out_dir)) {
-        launchers->Get(tool)->Error("launchers." + tool + ": " + *missing);
+        launchers->Get(tool)->Error(*missing);
       }
     }
     for (const auto& t : tool_names) launchers->Known({t});

@@ -96,7 +96,7 @@ class LutPackStage : public Stage {
       s.shards = ShardsOr(m, shards_);
       if (s.shards > TimeMappingSlices(time_mapping_)) {
         (m.Has("shards") ? *m.Get("shards") : n)
-            .Error(fmt::format("shards: {} shards for the {} slices of time mapping {}: at most one shard per slice",
+            .Error(fmt::format("{} shards for the {} slices of time mapping {}: at most one shard per slice",
                                s.shards, TimeMappingSlices(time_mapping_), time_mapping_));
       }
       m.Finish();
