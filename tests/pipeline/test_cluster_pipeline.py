@@ -154,18 +154,41 @@ class ClusterBakeTest(ReducedPipeline):
         super().setUp()
         self.cluster = self.path("slurm")
         r = run([os.path.join(SRC, "scripts", "cluster-up"), self.cluster], timeout=120)
-        self.addCleanup(run, [os.path.join(SRC, "scripts", "cluster-down"), self.cluster])
-        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+        if r.returncode != 0:  # tearDown does not run after a failed setUp: stop what did start
+            run([os.path.join(SRC, "scripts", "cluster-down"), self.cluster])
+            super().tearDown()
+            self.fail("scripts/cluster-up failed:\n" + r.stdout + r.stderr)
+        self.cluster_started = True
         self.env = dict(os.environ)
         for m in re.finditer(r"^export (\w+)=(.*)$", r.stdout, re.M):
             self.env[m.group(1)] = m.group(2).replace("$PATH", os.environ.get("PATH", ""))
         self.out = self.path("outputs_slurm")
+
+    def tearDown(self):
+        # Before the temporary folder (with the daemons' pid files) is removed.
+        if getattr(self, "cluster_started", False):
+            r = run([os.path.join(SRC, "scripts", "cluster-down"), self.cluster])
+            self.assertEqual(r.returncode, 0, r.stderr)
+        super().tearDown()
 
     def slurm(self, *args, expect=0, check=True):
         r = run(["ninja", "-C", self.out, "-j", "4"] + list(args), env=self.env)
         if check:
             self.assertEqual(r.returncode, expect, r.stdout + r.stderr)
         return r
+
+    @staticmethod
+    def tool_running(needle):
+        """Whether a sky-render process (not its srun) has `needle` in its command line."""
+        for pid in os.listdir("/proc"):
+            try:
+                with open("/proc/%s/cmdline" % pid, "rb") as f:
+                    cmd = f.read().replace(b"\0", b" ").decode(errors="replace")
+            except OSError:
+                continue
+            if needle in cmd and "sky-render" in cmd.split(" ")[0]:
+                return True
+        return False
 
     def jobs(self):
         """Completed Slurm jobs by name (jobcomp/filetxt: one line per finished job)."""
@@ -217,18 +240,22 @@ class ClusterBakeTest(ReducedPipeline):
             old = f.read()
         bake = subprocess.Popen(["ninja", "-C", self.out, "-j", "4", "-k", "0"], env=self.env, stdout=subprocess.PIPE,
                                 stderr=subprocess.STDOUT, text=True)
+        # Cancelled once the tool itself runs on the node (its process exists), not while the
+        # job waits or its step launches.
         cancelled = None
         deadline = time.time() + 120
         while cancelled is None and time.time() < deadline and bake.poll() is None:
-            q = run(["squeue", "-h", "-t", "R", "-o", "%i %j"], env=self.env)
-            for line in q.stdout.split("\n"):
-                if line.endswith(" " + victim):
-                    cancelled = line.split()[0]
-                    run(["scancel", cancelled], env=self.env)
-            time.sleep(0.05)
+            if self.tool_running("-o " + victim):
+                q = run(["squeue", "-h", "-o", "%i %j"], env=self.env)
+                for line in q.stdout.split("\n"):
+                    if line.endswith(" " + victim):
+                        cancelled = line.split()[0]
+                        run(["scancel", cancelled], env=self.env)
+            time.sleep(0.02)
         out, _ = bake.communicate(timeout=300)
         self.assertIsNotNone(cancelled, "the shard's job was never seen running:\n" + out)
         self.assertNotEqual(bake.returncode, 0, out)
+        print("\n--- the bake with a cancelled shard ---\n" + out)
         self.assertIn("FAILED: " + victim, out)
         self.assertIn("CANCELLED", out)
         # The shard's file is its previous complete version (the tool writes by rename).
