@@ -90,7 +90,7 @@ def main():
     a = ap.parse_args()
     shutil.rmtree(a.work, ignore_errors=True)
     os.makedirs(a.work)
-    for d in ("atmospheres", "particles", "ocio"):
+    for d in ("atmospheres", "particles", "ocio", "clouds"):
         shutil.copytree(os.path.join(os.path.dirname(os.path.abspath(a.pipeline)), d), os.path.join(a.work, d))
     text = open(a.pipeline).read()
     text = re.sub(r"^outputs:.*$", "outputs: outputs", text, flags=re.M)
