@@ -7,6 +7,8 @@
 //   sky-render points ATMOSPHERE.yaml --geometry in.csv -o out.csv [--wavelengths-out 440,550,680]
 //   sky-render budget ATMOSPHERE.yaml -o budget.csv [--tolerance 1%] [--method ms-approx] ...
 //   sky-render fog ATMOSPHERE.yaml -o fog.exr [--method orders|path] [--cut-altitude-km 1] ... (docs/fog.md)
+//   sky-render render ... --shard K/N -o part_K.exr   then   sky-render merge part_*.exr -o sky.exr [--preview sky.png]
+//              (shards of one render and their merge, the unsharded bytes; docs/cluster.md)
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -34,6 +36,7 @@
 #include "transport/points.h"
 #include "transport/sky_render.h"
 #include "transport/sky_scene.h"
+#include "transport/sky_shard.h"
 #include "io/size.h"
 
 namespace fs = std::filesystem;
@@ -95,6 +98,9 @@ int main(int argc, char** argv) {
                      "(docs/lut-pack.md)")
       ->excludes(sza);
   render->add_option("--observer-altitude-m", ro.observer_altitude_m, "Override the atmosphere's observer altitude (m)");
+  render->add_option("--shard", ro.shard,
+                     "Render only shard K of N (K/N, 0 <= K < N): a contiguous range of the slices (path: of the "
+                     "slices' texels), joined by sky-render merge into the unsharded bytes (docs/cluster.md)");
   render->add_option("--preview", ro.preview, "Also write a PNG preview (one row per sun angle, through the OCIO view)");
   render->add_option("--display", ro.display, "Preview display: sRGB, Rec.1886 Rec.709 or Rec.2100-PQ")->default_val("sRGB");
   render->add_option("--white-cd-m2", ro.white, "Preview: luminance shown as white, or 'auto' per row")->default_val("auto");
@@ -165,7 +171,52 @@ int main(int argc, char** argv) {
   fog->add_option("--attenuation-size", att_size, "Attenuation LUT nodes, WxH (u = depth^(1/3), v = elevation^(1/2))")
       ->default_val("64x64");
 
+  CLI::App* merge = cli.app().add_subcommand(
+      "merge", "Join the shard files of one render (render --shard K/N, every K) into the unsharded render's bytes");
+  std::vector<std::string> merge_inputs;
+  RenderOptions mo;
+  std::string merge_ocio;
+  merge->add_option("shards", merge_inputs, "The N shard EXRs, in any order")->required();
+  merge->add_option("-o,--output", output, "Output file")->required();
+  merge->add_option("--depfile", depfile, "Write a Make-style depfile of every file read");
+  merge->add_option("--preview", mo.preview, "Also write the PNG preview render --preview writes");
+  merge->add_option("--display", mo.display, "Preview display: sRGB, Rec.1886 Rec.709 or Rec.2100-PQ")->default_val("sRGB");
+  merge->add_option("--white-cd-m2", mo.white, "Preview: luminance shown as white, or 'auto' per row")->default_val("auto");
+  merge->add_option("--exposure", mo.exposure_stops, "Preview exposure in stops")->default_val(0.0);
+  merge->add_option("--ocio-config", merge_ocio, "OCIO config of the preview (default: $SKYBAKE_OCIO or the repo's ocio/config.ocio)");
+
   return cli.Run(argc, argv, [&] {
+    if (merge->parsed()) {
+      const fs::path ocio = ColorConfig::ResolvePath(merge_ocio);
+      if (!mo.preview.empty()) CheckPreviewOptions(ocio, mo);
+      std::vector<ShardFile> shards;
+      std::vector<fs::path> read;
+      for (const std::string& f : merge_inputs) {
+        shards.push_back({f, ReadExrParts(f)});
+        read.push_back(f);
+      }
+      const std::vector<ExrPart> parts = MergeRenderShards(shards);
+      WriteExrParts(output, parts);
+      if (!mo.preview.empty()) {
+        std::vector<std::vector<float>> slices;
+        for (const ExrPart& p : parts) {
+          if (p.name == "transmittance" || p.name == "sun" || p.name == "irradiance") continue;
+          std::vector<float> rgb(static_cast<size_t>(p.image.width) * p.image.height * 3);
+          const int channel[3] = {p.image.ChannelIndex("R"), p.image.ChannelIndex("G"), p.image.ChannelIndex("B")};
+          for (size_t t = 0; t < rgb.size() / 3; ++t) {
+            for (size_t c = 0; c < 3; ++c) {
+              rgb[t * 3 + c] = p.image.pixels[t * p.image.channels.size() + static_cast<size_t>(channel[c])];
+            }
+          }
+          slices.push_back(std::move(rgb));
+        }
+        WritePreviewOfReference(ocio, mo, parts.front().image.width, parts.front().image.height, slices, mo.preview);
+        read.push_back(ocio);
+      }
+      cli.Info(fmt::format("{} shards merged", shards.size()));
+      if (!depfile.empty()) WriteDepfile(depfile, output, read);
+      return;
+    }
     if (fog->parsed()) {
       auto size = [](const std::string& text, const char* opt, int* w, int* h) {
         const std::optional<Size2> s = ParseSize(text, 2, 4096);

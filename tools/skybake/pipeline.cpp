@@ -1,6 +1,11 @@
 #include "pipeline.h"
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <optional>
 #include <set>
 
 #include <fmt/format.h>
@@ -18,6 +23,33 @@ std::vector<double> PipelineWavelengths::Values() const {
   for (size_t i = 0; i <= n; ++i) v.push_back(min_nm + static_cast<double>(i) * step_nm);
   return v;
 }
+
+namespace {
+
+// The launcher's command (its first word) as Ninja's shell will find it: a path (relative to the
+// outputs folder, where ninja runs) or a name on PATH. Returns what is wrong, or nullopt.
+std::optional<std::string> MissingLauncher(const std::string& prefix, const fs::path& out_dir) {
+  const size_t begin = prefix.find_first_not_of(" \t");
+  if (begin == std::string::npos) return std::nullopt;  // an empty prefix runs the tool itself
+  const std::string command = prefix.substr(begin, prefix.find_first_of(" \t", begin) - begin);
+  auto runnable = [](const fs::path& f) { return access(f.c_str(), X_OK) == 0 && !fs::is_directory(f); };
+  if (command.find('/') != std::string::npos) {
+    const fs::path f = fs::path(command).is_absolute() ? fs::path(command) : out_dir / command;
+    if (runnable(f)) return std::nullopt;
+    return "'" + command + "' is not an executable file";
+  }
+  const char* path = std::getenv("PATH");
+  std::string dirs = path ? path : "";
+  for (size_t at = 0; at <= dirs.size();) {
+    const size_t end = std::min(dirs.find(':', at), dirs.size());
+    const std::string dir = dirs.substr(at, end - at);
+    if (runnable(fs::path(dir.empty() ? "." : dir) / command)) return std::nullopt;
+    at = end + 1;
+  }
+  return "'" + command + "' is not on PATH: install it (e.g. Slurm's srun) where skybake generates the graph, or change the launcher";
+}
+
+}  // namespace
 
 Pipeline LoadPipeline(const fs::path& path, const std::vector<Stage*>& stages) {
   Pipeline p;
@@ -62,6 +94,10 @@ Pipeline LoadPipeline(const fs::path& path, const std::vector<Stage*>& stages) {
       std::string tool = it->first.Scalar();
       if (std::find(tool_names.begin(), tool_names.end(), tool) == tool_names.end()) continue;  // reported by Finish
       p.launchers[tool] = launchers->String(tool, "a command prefix");
+      // A missing launcher fails here, not when ninja first runs the tool mid-bake.
+      if (std::optional<std::string> missing = MissingLauncher(p.launchers[tool], p.out_dir)) {
+        launchers->Get(tool)->Error(*missing);
+      }
     }
     for (const auto& t : tool_names) launchers->Known({t});
     launchers->Finish();

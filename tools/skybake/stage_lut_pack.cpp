@@ -16,6 +16,8 @@
 //       - {atmosphere: clear, size: 32x128}
 //       - {atmosphere: cloudy0, size: 16x64}
 //       - {atmosphere: hazed, size: 32x128, quality: high}  # this sky's quality instead of the section's
+//     shards: 4                    # each render as 4 shard edges + a merge (a sky may name its own;
+//                                  # docs/cluster.md), at most one per slice of the time mapping
 // Each render edge depends on its atmosphere's render component (written by the sky-render
 // stage), profiles and Mie tables, so an edit to one atmosphere re-renders only its LUT and re-runs
 // the pack edge, whose unchanged textures keep their bytes and times (write-if-changed + restat).
@@ -26,6 +28,7 @@
 
 #include "atmosphere/spec.h"
 #include "paths.h"
+#include "shards.h"
 #include "stage.h"
 #include "stage_helpers.h"
 #include "io/size.h"
@@ -38,6 +41,7 @@ struct LutSky {
   std::string atmosphere;
   std::string size;
   std::string quality;  // the section's unless the sky names its own
+  int shards = 1;       // the section's unless the sky names its own
   FileLoc loc;
 };
 
@@ -70,6 +74,7 @@ class LutPackStage : public Stage {
       }
     }
     budget_mib_ = luts->NumberOr("budget_mib", NumberSpec::Positive("MiB"), budget_mib_);
+    shards_ = ShardsOr(*luts, shards_);
     std::set<std::string> seen;
     for (const YamlNode& n : luts->Seq("skies")) {
       YamlMap m = n.ToMap("a mapping {atmosphere: NAME, size: WxH[, quality: low|medium|high]}");
@@ -81,6 +86,12 @@ class LutPackStage : public Stage {
       if (!size.empty() && !ParseSize(size, 2, 4096)) m.Get("size")->ErrorExpected(SizeExpected(2, 4096, "32x128"));
       s.size = size;
       s.quality = m.ChoiceOr("quality", {"low", "medium", "high"}, quality_);
+      s.shards = ShardsOr(m, shards_);
+      if (s.shards > TimeMappingSlices(time_mapping_)) {
+        (m.Has("shards") ? *m.Get("shards") : n)
+            .Error(fmt::format("{} shards for the {} slices of time mapping {}: at most one shard per slice",
+                               s.shards, TimeMappingSlices(time_mapping_), time_mapping_));
+      }
       m.Finish();
       if (!s.atmosphere.empty() && !seen.insert(s.atmosphere).second) n.Error("basis sky '" + s.atmosphere + "' is listed twice");
       skies_.push_back(s);
@@ -93,6 +104,9 @@ class LutPackStage : public Stage {
     if (!enabled_) return;
     const std::string pool = ctx.pipeline().pools.count("render") ? "render" : "";
     ctx.ninja().Rule(ToolRule(ctx, "lut_render", "sky-render", pool));
+    bool sharded = false;
+    for (const LutSky& s : skies_) sharded = sharded || s.shards > 1;
+    if (sharded) ctx.ninja().Rule(ShardMergeRule(ctx, "lut_merge", "sky-render"));
     NinjaRule r;
     r.name = "lut_pack";
     r.command = ctx.LauncherPrefix(tool()) + ctx.ToolPath(tool()) + " --quiet pack $skies $args --depfile $out.d -o $out";
@@ -124,7 +138,7 @@ class LutPackStage : public Stage {
                                      time_mapping_);
       if (spectral_stride_ > 1) args += fmt::format(" --spectral-stride {}", spectral_stride_);
       b.variables = {{"args", args}};
-      ctx.Build("sky-render", b);
+      BuildSharded(ctx, "sky-render", b, "", s.shards, "lut_merge");
       packed.emplace_back(a->name, b.outputs[0]);
     }
     diags.ThrowIfAny();
@@ -154,6 +168,7 @@ class LutPackStage : public Stage {
   std::string time_mapping_ = "gt7-quadratic";
   std::string exposure_stops_ = "auto";
   double budget_mib_ = 3.5;
+  int shards_ = 1;
   std::vector<LutSky> skies_;
 };
 

@@ -15,6 +15,8 @@
 //     target_error: 0.05           # relative standard error of Y per texel
 //     preview: true
 //     atmospheres: [clear, hazed]  # optional: only these get a reference render (default: all)
+//     shards: 4                    # each render as 4 shard edges (slices x texels) + a merge
+//                                  # that writes the EXR and the preview (docs/cluster.md)
 #include <fmt/format.h>
 
 #include <map>
@@ -22,6 +24,7 @@
 
 #include "atmosphere/spec.h"
 #include "paths.h"
+#include "shards.h"
 #include "stage.h"
 #include "stage_helpers.h"
 #include "io/size.h"
@@ -49,6 +52,13 @@ class SkyRenderStage : public Stage {
     if (sky->Has("sun_zenith_deg")) sun_zenith_deg_ = sky->NumberList("sun_zenith_deg", NumberSpec::Range(0, 180, "degrees"));
     target_error_ = sky->NumberOr("target_error", NumberSpec::Range(1e-4, 1.0, ""), target_error_);
     preview_ = sky->BoolOr("preview", preview_);
+    shards_ = ShardsOr(*sky, shards_);
+    // A path render's shard task is a texel of a slice, at least one per mirror pair of texels.
+    const std::optional<Size2> grid = ParseSize(size_, 2, 8192);
+    const size_t tasks = sun_zenith_deg_.size() * (grid ? static_cast<size_t>(grid->width) * grid->height / 2 : 1);
+    if (static_cast<size_t>(shards_) > tasks) {
+      sky->Get("shards")->Error(fmt::format("{} shards for {} texel tasks of the render: at most one shard per task", shards_, tasks));
+    }
     if (std::optional<std::vector<YamlNode>> only = sky->OptionalSeq("atmospheres")) {
       only_.emplace();
       for (const YamlNode& n : *only) {
@@ -64,6 +74,7 @@ class SkyRenderStage : public Stage {
   void EmitRules(GenContext& ctx) const override {
     const std::string pool = ctx.pipeline().pools.count("render") ? "render" : "";
     ctx.ninja().Rule(ToolRule(ctx, "sky_render", tool(), pool));
+    if (shards_ > 1) ctx.ninja().Rule(ShardMergeRule(ctx, "sky_merge", tool()));
   }
 
   void EmitEdges(GenContext& ctx) const override {
@@ -94,9 +105,9 @@ class SkyRenderStage : public Stage {
           "--sun-zenith-deg {} --target-error {}",
           method_, paths::Profiles(a.name).generic_string(), FormatExact(wl.min_nm), FormatExact(wl.max_nm),
           FormatExact(wl.step_nm), mapping_, size_, zeniths, FormatExact(target_error_));
-      if (preview_) args += " --preview " + paths::SkyPreview(a.name).generic_string();
       b.variables = {{"args", args}};
-      ctx.Build(tool(), b);
+      BuildSharded(ctx, tool(), b, preview_ ? " --preview " + paths::SkyPreview(a.name).generic_string() : "", shards_,
+                   "sky_merge");
     }
   }
 
@@ -107,6 +118,7 @@ class SkyRenderStage : public Stage {
   std::vector<double> sun_zenith_deg_ = {30, 70, 85, 90, 94};
   double target_error_ = 0.05;
   bool preview_ = true;
+  int shards_ = 1;
   std::optional<std::set<std::string>> only_;  // sky.atmospheres
   std::map<std::string, FileLoc> only_loc_;
 };

@@ -2,10 +2,12 @@
 
 #include "atmosphere/ray_sphere.h"
 #include "transport/ambient.h"
+#include "transport/sky_shard.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <limits>
@@ -88,18 +90,29 @@ SkyRenderResult RenderSky(const PathTracer& tracer, const SkyRenderSettings& s, 
     }
   }
 
-  const size_t total_tasks = work.size() * s.sun_zenith_deg.size();
+  // The shard's tasks: (slice si, work item k) is task si * work.size() + k (transport/sky_shard.h).
+  const uint64_t nwork = work.size();
+  const auto [task_begin, task_end] =
+      ShardTasks({s.shard_index, s.shard_count}, nwork * static_cast<uint64_t>(s.sun_zenith_deg.size()));
+  const size_t total_tasks = static_cast<size_t>(task_end - task_begin);
   std::atomic<size_t> done{0};
   std::atomic<uint64_t> total_paths{0};
   for (size_t si = 0; si < s.sun_zenith_deg.size(); ++si) {
+    const uint64_t first = si * nwork;
+    const size_t k0 = static_cast<size_t>(std::clamp(task_begin, first, first + nwork) - first);
+    const size_t k1 = static_cast<size_t>(std::clamp(task_end, first, first + nwork) - first);
+    if (k0 >= k1) continue;  // another shard's slice
     SkySlice slice;
+    slice.index = si;
     slice.sun_zenith_deg = s.sun_zenith_deg[si];
     const double theta_s = slice.sun_zenith_deg * kPi / 180.0;
     const glm::dvec3 sun = DirectionFromAngles(theta_s, 0.0);
     slice.xyz.assign(texels * 3, std::numeric_limits<float>::quiet_NaN());
     slice.y_stderr.assign(texels, std::numeric_limits<float>::quiet_NaN());
     slice.paths.assign(texels, 0.0f);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, work.size(), 1), [&](const tbb::blocked_range<size_t>& range) {
+    slice.owned.assign(texels, 0);
+    for (size_t k = k0; k < k1; ++k) slice.owned[work[k]] = slice.owned[mirror[work[k]]] = 1;
+    tbb::parallel_for(tbb::blocked_range<size_t>(k0, k1, 1), [&](const tbb::blocked_range<size_t>& range) {
       for (size_t k = range.begin(); k != range.end(); ++k) {
         const size_t t = work[k];
         const int x = static_cast<int>(t % static_cast<size_t>(W)), y = static_cast<int>(t / static_cast<size_t>(W));
@@ -119,7 +132,7 @@ SkyRenderResult RenderSky(const PathTracer& tracer, const SkyRenderSettings& s, 
         if (progress && (n % 64 == 0 || n == total_tasks)) progress("sky radiance", static_cast<double>(n) / total_tasks);
       }
     });
-    if (s.ambient) {
+    if (s.ambient && k0 == 0) {  // the slice's ambient belongs to the shard of its texel 0
       const uint64_t stream = (uint64_t{1} << 40) + si;
       slice.ambient = tracer.Irradiance(observer, sun, stream);
       total_paths += slice.ambient.paths;
@@ -179,10 +192,15 @@ SkyRenderResult RenderSkyDeterministic(const SkyMethod& method, const Atmosphere
   const size_t texels = static_cast<size_t>(W) * H;
   SkyRenderResult result;
   std::atomic<size_t> done{0};
-  const size_t total = s.sun_zenith_deg.size() * static_cast<size_t>(H);
-  for (double sza : s.sun_zenith_deg) {
+  // One task per slice (transport/sky_shard.h).
+  const auto [slice_begin, slice_end] = ShardTasks({s.shard_index, s.shard_count}, s.sun_zenith_deg.size());
+  const size_t total = static_cast<size_t>(slice_end - slice_begin) * static_cast<size_t>(H);
+  for (size_t si = static_cast<size_t>(slice_begin); si < static_cast<size_t>(slice_end); ++si) {
+    const double sza = s.sun_zenith_deg[si];
     SkySlice slice;
+    slice.index = si;
     slice.sun_zenith_deg = sza;
+    slice.owned.assign(texels, 1);
     const double theta_s = sza * kPi / 180.0;
     slice.xyz.assign(texels * 3, std::numeric_limits<float>::quiet_NaN());
     slice.y_stderr.assign(texels, 0.0f);

@@ -12,7 +12,8 @@
 // The radiance field is symmetric about the sun's vertical plane: mirrored texels (equirect
 // columns x <-> W-1-x, fisheye rows y <-> H-1-y) are computed once and copied.
 // Texels are independent tasks (TBB); each uses the random stream of its (slice, texel) index, so
-// results are identical at any thread count.
+// results are identical at any thread count, and a shard (transport/sky_shard.h: a contiguous
+// range of the render's tasks) computes its texels with the bytes the whole render gives them.
 #pragma once
 
 #include <array>
@@ -33,10 +34,17 @@ struct SkyRenderSettings {
   double observer_altitude_m = 0.0;
   bool ambient = true;
   int transmittance_angles = 181;  // view zenith 0..180 deg, uniform
+  // Shard shard_index of shard_count (transport/sky_shard.h): only that range of the render's
+  // tasks (path: slice x mirror-pair texel; deterministic methods: slices) is computed.
+  int shard_index = 0;
+  int shard_count = 1;
 };
 
 struct SkySlice {
+  size_t index = 0;  // in settings.sun_zenith_deg
   double sun_zenith_deg = 0.0;
+  // 1 where this render computed the texel (every texel unless sharded), else 0.
+  std::vector<uint8_t> owned;
   std::vector<float> xyz;       // [texel * 3 + c], cd/m^2; NaN outside the mapping
   std::vector<float> y_stderr;  // cd/m^2
   std::vector<float> paths;
@@ -46,7 +54,7 @@ struct SkySlice {
 };
 
 struct SkyRenderResult {
-  std::vector<SkySlice> slices;
+  std::vector<SkySlice> slices;  // the slices the shard touches (all, unsharded), in order
   std::vector<double> transmittance_zenith_deg;
   std::vector<double> transmittance;  // [angle * n_wl + wl]
   uint64_t total_paths = 0;

@@ -23,6 +23,7 @@
 #include "optics/mie_table.h"
 #include "spectrum/spectrum.h"
 #include "transport/rgb_color.h"
+#include "transport/sky_shard.h"
 #include "io/size.h"
 
 namespace fs = std::filesystem;
@@ -188,6 +189,21 @@ RenderProducts RenderProductsOf(const Scene& scene, const RenderOptions& o, cons
     throw UsageError("the observer must be inside the atmosphere");
   }
   if (!o.time_mapping.empty()) p.settings.sun_zenith_deg = TimeMappingOf(scene, o, p.settings.observer_altitude_m).SliceZenithDeg();
+  if (!o.shard.empty()) {
+    const std::optional<ShardSpec> shard = ParseShard(o.shard);
+    if (!shard) throw UsageError("--shard: expected K/N with 0 <= K < N <= 4096 (e.g. 0/4), got '" + o.shard + "'");
+    // A deterministic render's task is a slice; the path tracer's a texel of a slice, at least
+    // half the texels (one of each mirror pair).
+    const size_t slices = p.settings.sun_zenith_deg.size();
+    const size_t tasks = o.method == "path" ? slices * (static_cast<size_t>(w) * h / 2) : slices;
+    if (static_cast<size_t>(shard->count) > tasks) {
+      throw UsageError(fmt::format("--shard {}: this render has {} {}, fewer than {} shards", o.shard, tasks,
+                                   o.method == "path" ? "texel tasks" : "slices", shard->count));
+    }
+    if (!o.preview.empty()) throw UsageError("--preview: a shard writes no preview (sky-render merge --preview does)");
+    p.settings.shard_index = shard->index;
+    p.settings.shard_count = shard->count;
+  }
   if (o.method == "path") {
     PathTracer tracer(scene.model, scene.xyz_weights, scene.tracer);
     p.sky = RenderSky(tracer, p.settings, progress);
@@ -214,6 +230,8 @@ void WriteRender(const Scene& scene, const RenderOptions& o, const RenderProduct
   ColorProcessor to_reference = config.Converter(XyzColorSpace(scene.observer), ocio_names::kCieXyzD65);
   const SkyMapping& g = *p.settings.mapping;
   const size_t nw = scene.grid.size();
+  std::vector<double> slice_zenith_deg;  // the rendered slices' (all of them unless sharded)
+  for (const SkySlice& sl : p.sky.slices) slice_zenith_deg.push_back(sl.sun_zenith_deg);
   std::vector<ExrPart> parts;
   for (const SkySlice& sl : p.sky.slices) {
     std::vector<float> rgb = sl.xyz;
@@ -245,7 +263,7 @@ void WriteRender(const Scene& scene, const RenderOptions& o, const RenderProduct
     // Time-mapped renders name parts by slice index too: the GT7 mapping has 90 deg twice.
     const std::string part_name =
         o.time_mapping.empty() ? SliceName(sl.sun_zenith_deg)
-                               : fmt::format("sky.slice_{:02d}.sza_{:06.2f}", parts.size(), sl.sun_zenith_deg);
+                               : fmt::format("sky.slice_{:02d}.sza_{:06.2f}", sl.index, sl.sun_zenith_deg);
     parts.push_back({part_name, std::move(full)});
   }
   // Transmittance table (wavelength x view zenith).
@@ -265,7 +283,7 @@ void WriteRender(const Scene& scene, const RenderOptions& o, const RenderProduct
   {
     ExrTable t;
     t.axes.push_back({"wavelength", "nm", scene.grid.Describe(), scene.grid.wavelength_nm()});
-    t.axes.push_back({"sun_zenith", "deg", "sun zenith angle", p.settings.sun_zenith_deg});
+    t.axes.push_back({"sun_zenith", "deg", "sun zenith angle", slice_zenith_deg});
     t.channels = {"irradiance"};
     t.channel_units = {"W m^-2 nm^-1"};
     for (const SkySlice& sl : p.sky.slices) {
@@ -278,7 +296,7 @@ void WriteRender(const Scene& scene, const RenderOptions& o, const RenderProduct
   }
   {
     ExrTable t;
-    t.axes.push_back({"sun_zenith", "deg", "sun zenith angle", p.settings.sun_zenith_deg});
+    t.axes.push_back({"sun_zenith", "deg", "sun zenith angle", slice_zenith_deg});
     t.channels = {"sun_X", "sun_Y", "sun_Z", "sun_horizontal_Y", "ambient_X", "ambient_Y", "ambient_Z", "ambient_Y_stderr"};
     t.channel_units = {"lx", "lx", "lx", "lx", "lx", "lx", "lx", "lx"};
     for (const SkySlice& sl : p.sky.slices) {
@@ -300,11 +318,20 @@ void WriteRender(const Scene& scene, const RenderOptions& o, const RenderProduct
     SetProvenance(img, prov);
     parts.push_back({"irradiance", std::move(img)});
   }
+  if (p.settings.shard_count > 1) {  // transport/sky_shard.h
+    std::vector<std::vector<uint8_t>> owned;
+    for (const SkySlice& sl : p.sky.slices) owned.push_back(sl.owned);
+    parts.push_back({kShardPart, ShardPart({p.settings.shard_index, p.settings.shard_count}, p.settings.sun_zenith_deg.size(),
+                                           p.sky.slices.empty() ? 0 : p.sky.slices.front().index, g.width(), g.height(),
+                                           owned)});
+  }
   WriteExrParts(path, parts);
 }
 
-void CheckPreviewOptions(const Scene& scene, const RenderOptions& o) {
-  ColorConfig config = ColorConfig::Load(scene.ocio_config);
+void CheckPreviewOptions(const Scene& scene, const RenderOptions& o) { CheckPreviewOptions(scene.ocio_config, o); }
+
+void CheckPreviewOptions(const fs::path& ocio_config, const RenderOptions& o) {
+  ColorConfig config = ColorConfig::Load(ocio_config);
   const std::vector<std::string> displays = config.Displays();
   if (std::find(displays.begin(), displays.end(), o.display) == displays.end()) {
     throw UsageError(fmt::format("--display {}: expected one of the OCIO config's displays: {}", o.display,
@@ -323,16 +350,29 @@ void CheckPreviewOptions(const Scene& scene, const RenderOptions& o) {
 
 void WriteRenderPreview(const Scene& scene, const RenderOptions& o, const RenderProducts& p, const fs::path& path) {
   ColorConfig config = ColorConfig::Load(scene.ocio_config);
-  const SkyMapping& g = *p.settings.mapping;
-  const size_t texels = static_cast<size_t>(g.width()) * g.height();
-  std::vector<uint8_t> montage;
   ColorProcessor to_reference = config.Converter(XyzColorSpace(scene.observer), ocio_names::kCieXyzD65);
+  std::vector<std::vector<float>> rows;
   for (const SkySlice& sl : p.sky.slices) {
     std::vector<float> rgb = sl.xyz;
     for (float& v : rgb) {
       if (!std::isfinite(v)) v = 0.0f;  // outside the mapping: black
     }
     to_reference.Apply(rgb);
+    rows.push_back(std::move(rgb));
+  }
+  WritePreviewOfReference(scene.ocio_config, o, p.settings.mapping->width(), p.settings.mapping->height(), rows, path);
+}
+
+void WritePreviewOfReference(const fs::path& ocio_config, const RenderOptions& o, int width, int height,
+                             const std::vector<std::vector<float>>& slices, const fs::path& path) {
+  ColorConfig config = ColorConfig::Load(ocio_config);
+  const size_t texels = static_cast<size_t>(width) * height;
+  std::vector<uint8_t> montage;
+  for (const std::vector<float>& slice : slices) {
+    std::vector<float> rgb = slice;
+    for (float& v : rgb) {
+      if (!std::isfinite(v)) v = 0.0f;  // outside the mapping: black
+    }
     DisplayView view;
     view.display = o.display;
     view.exposure_stops = o.exposure_stops;
@@ -348,10 +388,10 @@ void WriteRenderPreview(const Scene& scene, const RenderOptions& o, const Render
       view.white_cd_m2 = *w;
     }
     ColorProcessor display = config.Display(ocio_names::kCieXyzD65, view);
-    std::vector<uint8_t> row = EncodePreview8(g.width(), g.height(), rgb, display);
+    std::vector<uint8_t> row = EncodePreview8(width, height, rgb, display);
     montage.insert(montage.end(), row.begin(), row.end());
   }
-  WritePng8(path, g.width(), g.height() * static_cast<int>(p.sky.slices.size()), 3, montage);
+  WritePng8(path, width, height * static_cast<int>(slices.size()), 3, montage);
 }
 
 }  // namespace skybake

@@ -76,6 +76,8 @@ struct RenderOptions {
   // (lut/gt7_mapping.h; lut-pack, docs/lut-pack.md).
   std::string time_mapping;
   double observer_altitude_m = -1.0;  // < 0: the atmosphere's
+  // "K/N": render only shard K of N (transport/sky_shard.h); "" renders the whole sky.
+  std::string shard;
   std::string preview;
   std::string display = "sRGB";
   std::string white = "auto";
@@ -99,5 +101,11 @@ void WriteRenderPreview(const Scene& scene, const RenderOptions& options, const 
 // The preview options (display of the OCIO config, white 'auto' or a luminance in
 // (0, 1e9] cd/m^2, exposure in [-64, 64] stops), checked before any rendering; UsageError.
 void CheckPreviewOptions(const Scene& scene, const RenderOptions& options);
+void CheckPreviewOptions(const std::filesystem::path& ocio_config, const RenderOptions& options);
+// The preview of slices given in the CIE-XYZ-D65 reference space (what the EXR holds; NaN outside
+// the mapping shows black): sky-render merge writes a merged render's preview with it, the bytes
+// WriteRenderPreview writes for the unsharded render.
+void WritePreviewOfReference(const std::filesystem::path& ocio_config, const RenderOptions& options, int width, int height,
+                             const std::vector<std::vector<float>>& slices, const std::filesystem::path& path);
 
 }  // namespace skybake
