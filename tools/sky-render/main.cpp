@@ -8,7 +8,9 @@
 //   sky-render budget ATMOSPHERE.yaml -o budget.csv [--tolerance 1%] [--method ms-approx] ...
 //   sky-render fog ATMOSPHERE.yaml -o fog.exr [--method orders|path] [--cut-altitude-km 1] ... (docs/fog.md)
 //   sky-render render ... --shard K/N -o part_K.exr   then   sky-render merge part_*.exr -o sky.exr [--preview sky.png]
+//   sky-render fog ... --shard K/N -o part_K.exr      then   sky-render merge part_*.exr -o fog.exr
 //              (shards of one render and their merge, the unsharded bytes; docs/cluster.md)
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -23,8 +25,10 @@
 #include "color/color.h"
 #include "color/exr_color.h"
 #include "fog/fog_render.h"
+#include "fog/fog_shard.h"
 #include "io/cli.h"
 #include "io/csv.h"
+#include "io/error.h"
 #include "io/exr.h"
 #include "io/fileio.h"
 #include "io/repo_paths.h"
@@ -143,7 +147,7 @@ int main(int argc, char** argv) {
   add_scene_options(fog);
   fog::FogRenderOptions fo;
   double cut_km = 1.0;
-  std::string lut_size = "32x32", att_size = "64x64", lut_texels = "nodes";
+  std::string lut_size = "32x32", att_size = "64x64", lut_texels = "nodes", fog_shard;
   fog->add_option("--method", fo.method, "orders (deterministic, all orders) or path (the Monte-Carlo reference)")
       ->default_val("orders");
   fog->add_option("--quality", fo.method_options.quality, "orders: low, medium or high")->default_val("medium");
@@ -170,9 +174,13 @@ int main(int argc, char** argv) {
   fog->add_option("--depths", fo.depths, "Depth tables: normalised depths (j/n)^3, j = 1..n")->default_val(32);
   fog->add_option("--attenuation-size", att_size, "Attenuation LUT nodes, WxH (u = depth^(1/3), v = elevation^(1/2))")
       ->default_val("64x64");
+  fog->add_option("--shard", fog_shard,
+                  "Render only shard K of N (K/N, 0 <= K < N): a contiguous range of the LUT slices, then the depth "
+                  "tables (shard 0 also the transmittances), joined by sky-render merge into the unsharded bytes "
+                  "(docs/cluster.md)");
 
   CLI::App* merge = cli.app().add_subcommand(
-      "merge", "Join the shard files of one render (render --shard K/N, every K) into the unsharded render's bytes");
+      "merge", "Join the shard files of one render (render or fog --shard K/N, every K) into the unsharded render's bytes");
   std::vector<std::string> merge_inputs;
   RenderOptions mo;
   std::string merge_ocio;
@@ -195,7 +203,23 @@ int main(int argc, char** argv) {
         shards.push_back({f, ReadExrParts(f)});
         read.push_back(f);
       }
-      const std::vector<ExrPart> parts = MergeRenderShards(shards);
+      // The first shard file says the render's kind (fog or sky); a shard of the other kind is
+      // refused by name (a file that is no shard at all, by the merge).
+      auto is_shard = [](const ShardFile& f) {
+        return std::any_of(f.parts.begin(), f.parts.end(), [](const ExrPart& p) { return p.name == kShardPart; });
+      };
+      const auto first = std::find_if(shards.begin(), shards.end(), is_shard);
+      const ShardFile& kind_file = first == shards.end() ? shards.front() : *first;
+      const bool fog_shards = fog::IsFogShard(kind_file.parts);
+      for (const ShardFile& f : shards) {
+        if (is_shard(f) && fog::IsFogShard(f.parts) != fog_shards) {
+          throw InputError(FileLoc{f.path, 0}, fmt::format("a shard of a {} render, but {} is a shard of a {} render",
+                                                           fog_shards ? "sky" : "fog", kind_file.path,
+                                                           fog_shards ? "fog" : "sky"));
+        }
+      }
+      if (fog_shards && !mo.preview.empty()) throw UsageError("--preview: a fog render has no preview");
+      const std::vector<ExrPart> parts = fog_shards ? fog::MergeFogShards(shards) : MergeRenderShards(shards);
       WriteExrParts(output, parts);
       if (!mo.preview.empty()) {
         std::vector<std::vector<float>> slices;
@@ -231,10 +255,13 @@ int main(int argc, char** argv) {
       fo.texel_grid = *grid;
       if (!(cut_km > 0.0 && cut_km < 1e4)) throw UsageError("--cut-altitude-km: expected a positive altitude in km");
       fo.cut_altitude_m = cut_km * 1e3;
+      if (!fog_shard.empty()) fo.shard = fog::ParseFogShard(fog_shard, fo);
       Scene s = LoadScene(scene, cli.Progress());
       const fog::FogRender r = fog::RenderFog(s, fo, cli.Progress());
       fog::WriteFogRender(s, fo, r, output, cli.name());
-      cli.Info(fmt::format("{} fog LUT slices, {} depth tables", r.slice_zenith_deg.size(), r.tables.size()));
+      const fog::FogShardRange own = fog::FogShardRangeOf(fo.shard, r.slice_zenith_deg.size(), r.tables.size());
+      cli.Info(fmt::format("{} fog LUT slices, {} depth tables", own.slice_end - own.slice_begin,
+                           own.table_end - own.table_begin));
       if (!depfile.empty()) WriteDepfile(depfile, output, s.files_read);
       return;
     }

@@ -19,7 +19,9 @@
 // Radiances are CIE-XYZ-D65 (cd/m^2) from the scene's observer, as sky-render render writes.
 //
 // Deterministic: work is split by output element (TBB), the path tracer draws one stream per
-// (product, element); the bytes are the same at any thread count.
+// (product, element); the bytes are the same at any thread count. A shard (fog/fog_shard.h:
+// a contiguous range of the LUT slices and depth tables) computes its elements with the same
+// bytes, and sky-render merge joins the shards into the unsharded file.
 #pragma once
 
 #include <filesystem>
@@ -32,6 +34,7 @@
 #include "lut/gt7_mapping.h"
 #include "transport/sky_method.h"
 #include "transport/sky_scene.h"
+#include "transport/sky_shard.h"
 
 namespace skybake::fog {
 
@@ -53,6 +56,8 @@ struct FogRenderOptions {
   int depths = 32;       // n
   // Attenuation nodes.
   int attenuation_width = 64, attenuation_height = 64;
+  // Render only this shard's tasks (fog/fog_shard.h); 0/1 renders everything.
+  ShardSpec shard;
 };
 
 // The depth grid x_j = (j/n)^3, j = 1..n, and the elevation grid e_i = 90 (i/(m-1))^2 deg.
@@ -72,6 +77,7 @@ struct FogRender {
   std::string method;      // "orders" or "path"
   std::string method_description;
   std::string observer;    // colour-matching functions, e.g. "cie2006_2deg"
+  ShardSpec shard;         // the shard rendered (0/1: the whole render; fog/fog_shard.h)
   double planet_radius_m = 0.0, top_altitude_m = 0.0, observer_altitude_m = 0.0, cut_altitude_m = 0.0;
   std::vector<double> wavelength_nm;
   std::vector<double> sun_e0;  // W m^-2 nm^-1 per wavelength (extraterrestrial)
@@ -100,15 +106,20 @@ struct FogRender {
   size_t TableIndex(size_t e, size_t a, size_t j) const { return (e * azimuth_deg.size() + a) * depth_x.size() + j; }
 };
 
+// The part names of LUT slice k and of the depth table at a sun zenith angle (deg).
+std::string FogSlicePartName(size_t k, double sun_zenith_deg);
+std::string FogTablePartName(double sun_zenith_deg);
+
 // Renders everything above. UsageError for a method without view segments, a cut below the
 // observer or above the top, bad sizes.
 FogRender RenderFog(const Scene& scene, const FogRenderOptions& options, const ProgressFn& progress);
 
 // The multi-part EXR (docs/fog.md, "Reference renders"): parts fog.slice_NN.sza_DDD.DD, depth.sza_DDD.DD,
-// depth_transmittance, attenuation, sun; provenance from the scene.
+// depth_transmittance, attenuation, sun; provenance from the scene. A shard writes the parts it
+// computed and its "shard" part (fog/fog_shard.h).
 void WriteFogRender(const Scene& scene, const FogRenderOptions& options, const FogRender& render,
                     const std::filesystem::path& path, const std::string& tool);
-// Reads and validates (InputError(path) for anything that is not a fog render).
+// Reads and validates (InputError(path) for anything that is not a fog render, a shard included).
 FogRender ReadFogRender(const std::filesystem::path& path);
 
 }  // namespace skybake::fog

@@ -1,7 +1,7 @@
 // Looking up what a decoded EXR part carries besides its pixels: a string or double attribute by
 // key (nullptr where the file has none), and the number in a part name of the form
 // "<prefix>NN.<rest>", the slices of sky-render's renders ("sky.slice_NN.sza_...",
-// transport/sky_scene.cpp) and fog renders ("fog.slice_NN....", fog/fog_render.cpp).
+// transport/sky_scene.cpp) and fog renders ("fog.slice_NN....", fog/fog_render_file.cpp).
 #pragma once
 
 #include <charconv>
