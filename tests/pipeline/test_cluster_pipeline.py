@@ -1,7 +1,7 @@
 """Sharded bakes (docs/cluster.md): the generator's shard edges, and a bake through a real Slurm.
 
-ShardedGraphTest (no scheduler): `shards: N` splits each render into N `--shard k/N` edges and a
-merge edge; bad shard counts and a launcher that is not installed fail at generate time with
+ShardedGraphTest (no scheduler): `shards: N` splits each render (sky references, LUT renders,
+fog renders) into N `--shard k/N` edges and a merge edge; bad shard counts and a launcher that is not installed fail at generate time with
 pipeline.yaml:line.
 
 ClusterBakeTest: scripts/cluster-up starts a one-node Slurm on loopback (munged, slurmctld,
@@ -41,6 +41,17 @@ luts:
   skies:
     - {{atmosphere: clear, size: 4x8}}
     - {{atmosphere: hazed, size: 4x8}}
+"""
+
+# The fog section of the reduced pipeline (lines 16-23 after PIPELINE): 5 LUT slices + 2 depth tables.
+FOG = """fog:
+  quality: low
+  time_mapping: "gt7:3+2"
+  lut_size: 4x8
+  attenuation_size: 8x8
+  depth_tables: {{sun_zenith_deg: [40, 85], elevations: 5, azimuths_deg: [0, 90, 180], depths: 8}}
+  shards: {shards}
+  skies: [clear, hazed]
 """
 
 TINY_PARTICLE = """refractive_index:
@@ -113,6 +124,42 @@ class ShardedGraphTest(ReducedPipeline):
         self.assertIn("--shard 2/4", text)
         self.assertRegex(text, r"build clear/sky.exr \| clear/sky.png: sky_merge clear/shards/sky.0-of-4.exr")
         self.assertIn("args = merge --preview clear/sky.png", text)
+
+    def test_fog_shards_become_shard_edges_and_a_merge(self):
+        self.pipeline("pipeline.yaml", "outputs", 1)
+        with open(self.path("pipeline.yaml"), "a") as f:
+            f.write(FOG.format(shards=3))
+        self.generate_ok()
+        with open(self.path("outputs", "build.ninja")) as f:
+            text = f.read()
+        for atm in ("clear", "hazed"):
+            shard_edges = re.findall(r"^build %s/shards/fog\.(\d)-of-3\.exr: fog_render %s/components/render\.yaml" % (atm, atm),
+                                     text, re.M)
+            self.assertEqual(shard_edges, ["0", "1", "2"])
+            for k in range(3):
+                self.assertRegex(text, r"build %s/shards/fog\.%d-of-3\.exr: [^\n]*\n(  [^\n]*\n)*  args = fog [^\n]* --shard %d/3\n"
+                                 % (atm, k, k))
+            self.assertIn("build %s/fog.exr: fog_merge %s/shards/fog.0-of-3.exr %s/shards/fog.1-of-3.exr "
+                          "%s/shards/fog.2-of-3.exr" % (atm, atm, atm, atm), text)
+            # The fit reads the merged render.
+            self.assertRegex(text, r"build fog/fog_%s\.json[^:]*: fog_fit %s/fog\.exr" % (atm, atm))
+        # One shard: one render edge, no merge.
+        self.pipeline("pipeline.yaml", "outputs", 1)
+        with open(self.path("pipeline.yaml"), "a") as f:
+            f.write(FOG.format(shards=1))
+        self.generate_ok()
+        with open(self.path("outputs", "build.ninja")) as f:
+            text = f.read()
+        self.assertNotIn("fog_merge", text)
+        self.assertNotIn("--shard", text)
+        self.assertRegex(text, r"build clear/fog\.exr: fog_render clear/components/render\.yaml")
+        # 8 shards for 7 tasks: refused at the key's line, no build.ninja written.
+        shutil.rmtree(self.path("outputs"))
+        self.pipeline("pipeline.yaml", "outputs", 1)
+        with open(self.path("pipeline.yaml"), "a") as f:
+            f.write(FOG.format(shards=8))
+        self.generate_fails("pipeline.yaml:22: key 'fog.shards': 8 shards for the 5 LUT slices of time mapping gt7:3+2 "
+                            "and 2 depth tables: at most one shard per slice or table")
 
     def generate_ok(self):
         r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)

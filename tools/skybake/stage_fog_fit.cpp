@@ -19,15 +19,18 @@
 //     angle: path                  # the fit's normalised angle: path or elevation (the talk's)
 //     channels: rgb                # a, p per channel, or one for all (luminance)
 //     params: per-slice-elevation  # a, p per fog LUT slice, a per elevation too (default); per-slice; global (the talk's)
+//     shards: 4                    # each render as 4 shard edges + a merge (docs/cluster.md), at
+//                                  # most one shard per LUT slice and depth table
 //     skies: [clear, hazed]        # atmospheres of the list above
-// One render edge and one fit edge per sky: an edit to one atmosphere re-runs only its two edges
-// (every fit writes only its own sky's files; write-if-changed + restat).
+// One render edge (or its shard edges and merge) and one fit edge per sky: an edit to one
+// atmosphere re-runs only its edges (every fit writes only its own sky's files; write-if-changed + restat).
 #include <fmt/format.h>
 
 #include <set>
 
 #include "atmosphere/spec.h"
 #include "paths.h"
+#include "shards.h"
 #include "stage.h"
 #include "stage_helpers.h"
 #include "io/size.h"
@@ -63,6 +66,15 @@ class FogFitStage : public Stage {
     angle_ = fog->ChoiceOr("angle", {"path", "elevation"}, angle_);
     channels_ = fog->ChoiceOr("channels", {"rgb", "luminance"}, channels_);
     params_ = fog->ChoiceOr("params", {"per-slice-elevation", "per-slice", "global"}, params_);
+    shards_ = ShardsOr(*fog, shards_);
+    // A fog render's shard task is a LUT slice or a depth table (fog/fog_shard.h).
+    const int tasks = TimeMappingSlices(time_mapping_) + static_cast<int>(sun_zenith_deg_.size());
+    if (shards_ > tasks) {
+      fog->Get("shards")->Error(fmt::format("{} shards for the {} LUT slices of time mapping {} and {} depth tables: at "
+                                            "most one shard per slice or table",
+                                            shards_, TimeMappingSlices(time_mapping_), time_mapping_,
+                                            sun_zenith_deg_.size()));
+    }
     std::set<std::string> seen;
     for (const YamlNode& n : fog->Seq("skies")) {
       const std::optional<std::string> s = n.ToString("the name of an atmosphere of the list above");
@@ -78,6 +90,7 @@ class FogFitStage : public Stage {
     if (!enabled_) return;
     const std::string pool = ctx.pipeline().pools.count("render") ? "render" : "";
     ctx.ninja().Rule(ToolRule(ctx, "fog_render", "sky-render", pool));
+    if (shards_ > 1) ctx.ninja().Rule(ShardMergeRule(ctx, "fog_merge", "sky-render"));
     ctx.ninja().Rule(ToolRule(ctx, "fog_fit", tool(), ""));
   }
 
@@ -106,7 +119,7 @@ class FogFitStage : public Stage {
                                           FormatExact(wl.min_nm), FormatExact(wl.max_nm), FormatExact(wl.step_nm),
                                           FormatExact(cut_km_), lut_size_, time_mapping_, attenuation_size_,
                                           join(sun_zenith_deg_), elevations_, join(azimuths_deg_), depths_)}};
-      ctx.Build("sky-render", r);
+      BuildSharded(ctx, "sky-render", r, "", shards_, "fog_merge");
 
       NinjaBuild f;
       f.outputs = {paths::FogParams(a->name).generic_string()};
@@ -147,6 +160,7 @@ class FogFitStage : public Stage {
   std::string angle_ = "path";
   std::string channels_ = "rgb";
   std::string params_ = "per-slice-elevation";
+  int shards_ = 1;
   std::vector<std::pair<std::string, FileLoc>> skies_;
 };
 
