@@ -70,15 +70,15 @@ class SkyRenderCli(CliContract, TempDirTestCase):
         self.assertEqual(r.returncode, 2)
         self.assertIn("sky-render: --quality: expected low, medium or high, got 'best'", r.stderr)
         atm = rayleigh_atmosphere(self.tmp)
-        for sub in ("points", "budget", "fog"):
-            r = run([tool("sky-render"), sub, atm, "-o", self.path("x.out"), "--quality", "Medium", "--quiet"])
+        for sub, extra in (("points", ["--geometry", self.path("g.csv")]), ("budget", []), ("fog", [])):
+            r = run([tool("sky-render"), sub, atm, "-o", self.path("x.out"), "--quality", "Medium", "--quiet"] + extra)
             self.assertEqual(r.returncode, 2, sub)
             self.assertIn("sky-render: --quality: expected low, medium or high, got 'Medium'", r.stderr)
         self.assertFalse(os.path.exists(self.path("sky.exr")))
         self.assertFalse(os.path.exists(self.path("x.out")))
         r = run([tool("sky-render"), "render", "--help"])
         self.assertEqual(r.returncode, 0)
-        self.assertRegex(r.stdout, r"--quality TEXT \[medium\] +Deterministic methods: low, medium or high")
+        self.assertRegex(r.stdout, r"--quality TEXT=medium +Deterministic methods: low, medium or high")
         self.assertIn("Rendering method: path (the Monte-Carlo reference), single, orders, ms-approx, analytic", r.stdout)
 
     def test_bad_atmosphere_is_located(self):

@@ -103,7 +103,9 @@ TEST(OrdersOverrides, KeysDerivedFromTheTypedTable) {
     o.table_size[ov.key] = ov.max + 1;
     EXPECT_EQ(UsageMessage([&] { orders::SettingsFor(o); }),
               fmt::format("orders: expert override '{}': expected {} to {}, got {}", ov.key, ov.min, ov.max, ov.max + 1));
-    if (ov.kind == orders::OrdersOverride::Kind::kFlag) EXPECT_EQ(ov.max, 1) << ov.key;
+    if (ov.kind == orders::OrdersOverride::Kind::kFlag) {
+      EXPECT_EQ(ov.max, 1) << ov.key;
+    }
   }
 }
 
