@@ -63,7 +63,9 @@ TEST(SkyMethodRegistry, NamesAndRows) {
   const AtmosphereModel m = Homogeneous(6371e3, 100e3, {1e-5}, {0.0}, std::make_shared<IsotropicPhase>(), 0.0);
   EXPECT_EQ(UsageMessage([&] { MakeSkyMethod("magic", m, {}, {}); }),
             "--method: expected path, single, orders, ms-approx, analytic; got 'magic'");
-  for (const std::string& name : SkyMethodNames()) EXPECT_EQ(MakeSkyMethod(name, m, {}, {})->Name(), name);
+  SkyMethodOptions low;
+  low.quality = Quality::kLow;
+  for (const std::string& name : SkyMethodNames()) EXPECT_EQ(MakeSkyMethod(name, m, low, {})->Name(), name);
 }
 
 // A key given to a method that reads none is an error naming the key, for every such method.
@@ -137,7 +139,7 @@ TEST(OrdersOverrides, EachKindSetsItsSetting) {
   EXPECT_EQ(s.sun_nr, 48);
 }
 
-// The preset tables hold the documented values (docs/sky-methods.md, "Quality presets").
+// The preset tables hold the documented values (docs/sky-methods.md, "Qualities").
 TEST(Presets, OrdersTable) {
   const auto& p = orders::OrdersPresets();
   const orders::OrdersSettings& lo = p[Quality::kLow];

@@ -1,4 +1,4 @@
-// The quality preset of the deterministic sky methods (docs/sky-methods.md, "Quality presets"):
+// The quality preset of the deterministic sky methods (docs/sky-methods.md, "Qualities"):
 // one enum for the command line (sky-render --quality), pipeline.yaml (luts.quality,
 // fog.quality) and every method's preset table, which is indexed by it.
 #pragma once
