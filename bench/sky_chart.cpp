@@ -144,7 +144,7 @@ int main(int argc, char** argv) {
   std::vector<double> elevations = {60, 20, 5, 0, -4, -10};
   bool no_variants = false, references_only = false;
   std::vector<std::string> methods;
-  std::vector<std::string> qualities = {"low", "medium", "high"};
+  std::vector<std::string> qualities = QualityNames();
   cli.app().add_option("--out", out_dir, "Output folder (CSV; references cached in <out>/references)");
   cli.app().add_option("--mie-dir", mie_dir, "Folder with the Mie tables of the atmospheres' particle types");
   cli.app().add_option("--atmospheres", atmospheres, "Atmospheres (atmospheres/<name>.yaml)")->delimiter(',');
@@ -155,7 +155,7 @@ int main(int argc, char** argv) {
   cli.app()
       .add_option("--qualities", qualities, "Qualities of the deterministic methods (default: low,medium,high)")
       ->delimiter(',')
-      ->check(CLI::IsMember({"low", "medium", "high"}));
+      ->check(CLI::IsMember(QualityNames()));
   return cli.Run(argc, argv, [&] {
     const fs::path root = SKYBAKE_SOURCE_DIR;
     const SkyDirections D = ChartDirections();
@@ -237,7 +237,7 @@ int main(int argc, char** argv) {
             std::vector<double> L;
             method->Radiance(sc.spec.observer_altitude_m, (90.0 - elevations[e]) * kPi / 180.0, D.dirs, &L);
             const double render_s = Seconds(t1);
-            record(elevations[e], e, name, o.quality, variant, build_s, render_s, SpectralToXyz(L, sc.xyz_weights));
+            record(elevations[e], e, name, QualityName(o.quality), variant, build_s, render_s, SpectralToXyz(L, sc.xyz_weights));
           }
         });
       };
@@ -245,7 +245,7 @@ int main(int argc, char** argv) {
       for (const std::string& name : methods) {
         for (const std::string& q : qualities) {
           SkyMethodOptions o;
-          o.quality = q;
+          o.quality = ParseQuality(q, "--qualities");
           run_method(scene, name, o, "");
         }
       }
@@ -285,7 +285,7 @@ int main(int argc, char** argv) {
                              : LoadScene(v.options, {});
         const Scene& use = sc.xyz_weights.empty() ? scene : sc;
         SkyMethodOptions o;
-        o.quality = "medium";
+        o.quality = Quality::kMedium;
         o.orders = v.orders;
         run_method(use, "ms-approx", o, v.name);
       }

@@ -61,7 +61,7 @@ BENCHMARK(SingleSlow)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 void Method(benchmark::State& state, const char* name, const char* quality) {
   const Geometry g = kGeometry[state.range(0)];
   SkyMethodOptions o;
-  o.quality = quality;
+  o.quality = ParseQuality(quality, "quality");
   const std::unique_ptr<SkyMethod> method = MakeSkyMethod(name, Clear().model, o, {});
   const double t = g.view * kDeg;
   const std::vector<std::array<double, 3>> dirs = {{std::sin(t) * std::cos(0.5), std::sin(t) * std::sin(0.5), std::cos(t)}};
@@ -89,7 +89,7 @@ void TransmittanceTableBuild(benchmark::State& state) {
 BENCHMARK(TransmittanceTableBuild)->Arg(64)->Arg(128)->Arg(256)->Unit(benchmark::kMillisecond);
 
 void MsLutBuild(benchmark::State& state, const char* quality) {
-  const MsApproxSettings s = MsApproxPreset(quality);
+  const MsApproxSettings s = MsApproxPreset(ParseQuality(quality, "quality"));
   const SingleScatteringModel ss(Clear().model, s.march);
   for (auto _ : state) {
     MultipleScatteringLut lut(ss, s, {});

@@ -64,6 +64,23 @@ class SkyRenderCli(CliContract, TempDirTestCase):
         self.assertIn("sky-render: --wavelengths: expected min:max:step in nm, got '400:700'", r.stderr)
         self.assertFalse(os.path.exists(self.path("sky.exr")))
 
+    def test_bad_quality_is_a_usage_error(self):
+        # --quality takes a preset name (transport/quality.h) in every subcommand, whatever the method.
+        r = self.render("--quality", "best")
+        self.assertEqual(r.returncode, 2)
+        self.assertIn("sky-render: --quality: expected low, medium or high, got 'best'", r.stderr)
+        atm = rayleigh_atmosphere(self.tmp)
+        for sub, extra in (("points", ["--geometry", self.path("g.csv")]), ("budget", []), ("fog", [])):
+            r = run([tool("sky-render"), sub, atm, "-o", self.path("x.out"), "--quality", "Medium", "--quiet"] + extra)
+            self.assertEqual(r.returncode, 2, sub)
+            self.assertIn("sky-render: --quality: expected low, medium or high, got 'Medium'", r.stderr)
+        self.assertFalse(os.path.exists(self.path("sky.exr")))
+        self.assertFalse(os.path.exists(self.path("x.out")))
+        r = run([tool("sky-render"), "render", "--help"])
+        self.assertEqual(r.returncode, 0)
+        self.assertRegex(r.stdout, r"--quality TEXT=medium +Deterministic methods: low, medium or high")
+        self.assertIn("Rendering method: path (the Monte-Carlo reference), single, orders, ms-approx, analytic", r.stdout)
+
     def test_bad_atmosphere_is_located(self):
         bad = self.write("bad.yaml", "planet: {radius_km: 6371, top_km: 100}\nair: {profile: ussa1976}\n"
                                      "sun: {angular_diameter_deg: 0.5}\n")

@@ -71,7 +71,7 @@ Scene ClearScene() {
 FogRenderOptions SmallOptions() {
   FogRenderOptions o;
   o.method = "orders";
-  o.method_options.quality = "low";
+  o.method_options.quality = Quality::kLow;
   o.cut_altitude_m = 1000.0;  // the default cut (docs/fog.md, "The cut")
   o.lut_width = 32;
   o.lut_height = 32;

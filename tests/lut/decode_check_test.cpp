@@ -77,7 +77,7 @@ const Scene& Clear(const std::string& method = "single") {
     XyzWeights w(grid, Cmf::LoadDefault(Observer::kCie1931_2deg));
     for (size_t i = 0; i < grid.size(); ++i) s->weights.push_back({w.wx()[i], w.wy()[i], w.wz()[i]});
     SkyMethodOptions o;
-    o.quality = "low";
+    o.quality = Quality::kLow;
     s->method = MakeSkyMethod(method, s->model, o, nullptr);
     s->spec = spec;
     return s;

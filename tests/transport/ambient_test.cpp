@@ -129,7 +129,7 @@ TEST(Ambient, NarrowAureoleAroundTheSun) {
 TEST(Ambient, ThinCloudAureole) {
   const TestScene sc = LoadTestScene("cloudy1");
   SkyMethodOptions o;
-  o.quality = "medium";
+  o.quality = Quality::kMedium;
   const std::unique_ptr<SkyMethod> m = MakeSkyMethod("orders", sc.model, o, {});
   AmbientQuadrature grid;
   grid.sun_cap = false;

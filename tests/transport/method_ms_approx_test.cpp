@@ -58,7 +58,7 @@ std::vector<double> MethodY(const TestScene& sc, const SkyMethod& method, double
 TEST(MethodMsApprox, TransferFractionIsAlbedoDeepInside) {
   const double ss = 8e-4, sa = 2e-4;  // omega = 0.8, 1 / km extinction
   const AtmosphereModel m = Homogeneous(6371e3, 100e3, {ss}, {sa}, std::make_shared<IsotropicPhase>(), 0.3, 101);
-  MsApproxSettings s = MsApproxPreset("medium");
+  MsApproxSettings s = MsApproxPreset(Quality::kMedium);
   s.lut_z = 3;  // nodes at 0, 50 and 100 km
   SingleScatteringModel ss_model(m, s.march);
   MultipleScatteringLut lut(ss_model, s, {});
@@ -75,7 +75,7 @@ TEST(MethodMsApprox, OrdersTruncateTheSeries) {
   const TestScene& sc = Clear();
   const std::vector<std::array<double, 3>> dirs = {Dir(0, 0), Dir(60, 90), Dir(85, 180)};
   SkyMethodOptions o;
-  o.quality = "low";
+  o.quality = Quality::kLow;
   std::vector<double> single, prev;
   MakeSkyMethod("single", sc.model, o, {})->Radiance(0.0, 1.0, dirs, &single);
   for (int orders : {1, 2, 3, 5, 0}) {
@@ -105,7 +105,7 @@ TEST(MethodMsApprox, IsotropicSecondOrderMatchesPathTracer) {
     if (c.phase) c.phase = std::make_shared<IsotropicPhase>();
   }
   sc.model.Finalize();
-  MsApproxSettings s = MsApproxPreset("high");
+  MsApproxSettings s = MsApproxPreset(Quality::kHigh);
   s.sqrt_dirs = 12;
   s.lut_mu_s = 64;
   s.lut_z = 32;
@@ -140,7 +140,7 @@ TEST(MethodMsApprox, ThinAndDenseAerosolAgainstPath) {
     so.aerosol_tau_550 = c.tau;
     const TestScene sc = LoadTestScene(c.atmosphere, so);
     SkyMethodOptions o;
-    o.quality = "medium";
+    o.quality = Quality::kMedium;
     std::unique_ptr<SkyMethod> ms = MakeSkyMethod("ms-approx", sc.model, o, {});
     std::unique_ptr<SkyMethod> single = MakeSkyMethod("single", sc.model, o, {});
     const std::vector<ColorEstimate> ref = PathY(sc, 30.0, dirs, 0.01);

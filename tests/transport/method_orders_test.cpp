@@ -52,7 +52,7 @@ SceneOptions TenNmGrid() {
 
 std::unique_ptr<SkyMethod> HighOrders(const TestScene& sc) {
   SkyMethodOptions o;
-  o.quality = "high";
+  o.quality = Quality::kHigh;
   return MakeSkyMethod("orders", sc.model, o, {});
 }
 
@@ -78,7 +78,7 @@ const std::vector<std::array<double, 3>>& SkyDirs() {
 TEST(MethodOrders, FirstOrderIsTheSingleScattering) {
   const TestScene sc = LoadTestScene("hazed");
   SkyMethodOptions o;
-  o.quality = "medium";
+  o.quality = Quality::kMedium;
   o.orders = 1;
   std::unique_ptr<SkyMethod> orders = MakeSkyMethod("orders", sc.model, o, {});
   std::unique_ptr<SkyMethod> single = MakeSkyMethod("single", sc.model, o, {});
@@ -135,7 +135,7 @@ TEST(MethodOrders, AgainstThePathTracerFromDaylightToTwilight) {
   for (const auto& [atm, cases] : sets) {
     const TestScene sc = LoadTestScene(atm);
     SkyMethodOptions o;
-    o.quality = "medium";
+    o.quality = Quality::kMedium;
     std::unique_ptr<SkyMethod> orders = MakeSkyMethod("orders", sc.model, o, {});
     for (const OrdersCase& c : cases) {
       const std::vector<ColorEstimate> ref = PathY(sc, c.sza, SkyDirs(), c.target);
@@ -237,7 +237,7 @@ TEST(MethodOrders, SecondOrderWithTheBasisKernel) {
   });
   auto errors = [&](const char* quality, int truncation_deg, double* rms, double* worst) {
     SkyMethodOptions o;
-    o.quality = quality;
+    o.quality = ParseQuality(quality, "quality");
     o.orders = 2;
     if (truncation_deg > 0) o.table_size["truncation_deg"] = truncation_deg;
     const std::vector<double> y = MethodY(sc, *MakeSkyMethod("orders", sc.model, o, {}), 70.0, dirs);
@@ -273,7 +273,7 @@ std::vector<double> LowOrdersOnAGrid(const TestScene& sc, int orders, const std:
     for (double az = 0.0; az <= 180.0; az += az_step) dirs.push_back(Dir(vz, az));
   }
   SkyMethodOptions o;
-  o.quality = "low";
+  o.quality = Quality::kLow;
   o.orders = orders;
   o.table_size = keys;
   const auto m = MakeSkyMethod("orders", sc.model, o, {});
@@ -332,7 +332,7 @@ TEST(MethodOrders, SplitGatherIsTheCellGather) {
 TEST(MethodOrders, SameResultAtAnyThreadCount) {
   const TestScene sc = LoadTestScene("clear");
   SkyMethodOptions o;
-  o.quality = "low";
+  o.quality = Quality::kLow;
   std::vector<double> a, b;
   {
     tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
@@ -355,7 +355,7 @@ TEST(MethodOrders, SunOnTheHorizonConvergedInTheSunNodes) {
   const TestScene sc = LoadTestScene("clear");
   const std::vector<std::array<double, 3>> dirs = {Dir(89.5, 40), Dir(89.5, 90), Dir(87, 40), Dir(80, 40), Dir(60, 40)};
   SkyMethodOptions o;
-  o.quality = "medium";
+  o.quality = Quality::kMedium;
   SkyMethodOptions fine = o;
   fine.table_size["low_sun_step_x10"] = 2;
   const std::vector<double> y = MethodY(sc, *MakeSkyMethod("orders", sc.model, o, {}), 90.0, dirs);
@@ -375,7 +375,7 @@ TEST(MethodOrders, OrdersConvergeAndTheTailIsAccurate) {
   std::vector<double> prev;
   for (int n : {2, 3, 5}) {
     SkyMethodOptions o;
-    o.quality = "low";
+    o.quality = Quality::kLow;
     o.orders = n;
     o.table_size["early_tail"] = 0;
     const std::vector<double> y = MethodY(sc, *MakeSkyMethod("orders", sc.model, o, {}), 60.0, SkyDirs());
@@ -385,12 +385,12 @@ TEST(MethodOrders, OrdersConvergeAndTheTailIsAccurate) {
     prev = y;
   }
   SkyMethodOptions all;
-  all.quality = "low";
+  all.quality = Quality::kLow;
   all.orders = 40;
   all.order_tolerance = 1e-7;
   all.table_size["early_tail"] = 0;
   SkyMethodOptions dflt;
-  dflt.quality = "low";
+  dflt.quality = Quality::kLow;
   dflt.order_tolerance = 1e-3;  // medium's and high's stopping rule on low's tables
   const std::vector<double> y_all = MethodY(sc, *MakeSkyMethod("orders", sc.model, all, {}), 60.0, SkyDirs());
   const std::vector<double> y_def = MethodY(sc, *MakeSkyMethod("orders", sc.model, dflt, {}), 60.0, SkyDirs());
@@ -438,7 +438,7 @@ TEST(MethodOrders, ThickCloudLayerConvergesWithinItsMeasuredError) {
   const std::vector<std::array<double, 3>> weights = {{0.0, 0.5, 0.0}, {0.0, 0.5, 0.0}};
   const std::vector<std::array<double, 3>> dirs = {Dir(0, 0), Dir(60, 0), Dir(60, 180), Dir(85, 90)};
   SkyMethodOptions o;
-  o.quality = "medium";
+  o.quality = Quality::kMedium;
   std::unique_ptr<SkyMethod> orders = MakeSkyMethod("orders", m, o, {});
   const std::string desc = orders->Describe();
   std::printf("%s", desc.c_str());
@@ -476,7 +476,7 @@ TEST(MethodOrders, TableRayStepsConvergeThroughAThickLayer) {
   std::vector<double> L[2];
   for (int k = 0; k < 2; ++k) {
     SkyMethodOptions o;
-    o.quality = "medium";
+    o.quality = Quality::kMedium;
     o.table_size["ray_steps"] = k == 0 ? 40 : 160;
     MakeSkyMethod("orders", m, o, {})->Radiance(1.0, 30.0 * kDeg, dirs, &L[k]);
   }
@@ -499,7 +499,7 @@ TEST(MethodOrders, OrdersConvergeUnderAThickWaterCloud) {
   std::vector<double> y[2];
   for (int i = 0; i < 2; ++i) {
     SkyMethodOptions o;
-    o.quality = "medium";
+    o.quality = Quality::kMedium;
     o.orders = i == 0 ? 40 : 80;
     const auto m = MakeSkyMethod("orders", sc.model, o, {});
     const std::string desc = m->Describe();
@@ -573,7 +573,7 @@ TEST(MethodOrders, ForwardOnlyLayerLeavesTheSkyAwayFromTheSun) {
     }
   }
   SkyMethodOptions o;
-  o.quality = "medium";
+  o.quality = Quality::kMedium;
   const std::vector<double> clear = MethodY(sc, *MakeSkyMethod("orders", floor, o, {}), sun, dirs);
   auto rms_max = [&](const std::vector<double>& y, double* mx) {
     double ss = 0.0;

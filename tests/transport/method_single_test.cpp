@@ -131,7 +131,7 @@ TEST(MethodSingle, HomogeneousSlabClosedForm) {
   const double R = 6371e3 * 1e4, H = 10e3;
   const double ss = 5e-5, sa = 1e-5;  // tau = 0.6
   const AtmosphereModel m = Homogeneous(R, H, {ss}, {sa}, std::make_shared<IsotropicPhase>(), 0.0);
-  MarchSettings s = SingleMarchSettings("high");
+  MarchSettings s = SingleMarchSettings(Quality::kHigh);
   s.disk_rings = 0;
   SingleScatteringModel model(m, s);
   const double tau = (ss + sa) * H, w0 = ss / (ss + sa), P = 1.0 / (4 * kPi);
@@ -180,7 +180,7 @@ TEST(MethodSingle, MatchesSlowQuadrature) {
   SingleScatteringModel::RayOptions point;
   point.point_sun = true;
   for (const auto& [quality, bound] : std::vector<std::pair<std::string, double>>{{"low", 0.25}, {"medium", 0.01}, {"high", 0.004}}) {
-    SingleScatteringModel model(m, SingleMarchSettings(quality));
+    SingleScatteringModel model(m, SingleMarchSettings(ParseQuality(quality, "quality")));
     double worst = 0.0;
     for (size_t k = 0; k < cases.size(); ++k) {
       const Case& c = cases[k];
@@ -203,7 +203,7 @@ TEST(MethodSingle, SunDiskQuadratureConverges) {
   const TestScene& sc = Clear();
   const AtmosphereModel& m = sc.model;
   const glm::dvec3 x(0, 0, m.bottom_radius_m + 1.0);
-  MarchSettings fine = SingleMarchSettings("high");
+  MarchSettings fine = SingleMarchSettings(Quality::kHigh);
   fine.disk_rings = 12;
   fine.disk_sectors = 24;
   SingleScatteringModel ref(m, fine);
@@ -212,7 +212,7 @@ TEST(MethodSingle, SunDiskQuadratureConverges) {
   };
   const std::vector<Case> cases = {{30, 30.3}, {30, 30.5}, {30, 31}, {30, 33}, {90, 89.7}, {90, 89.5}, {92, 80}, {94, 60}};
   for (const auto& [quality, bound] : std::vector<std::pair<std::string, double>>{{"low", 0.25}, {"medium", 0.03}, {"high", 1e-3}}) {
-    SingleScatteringModel model(m, SingleMarchSettings(quality));
+    SingleScatteringModel model(m, SingleMarchSettings(ParseQuality(quality, "quality")));
     double worst = 0.0;
     for (const Case& c : cases) {
       std::vector<double> L(m.wavelengths()), R(m.wavelengths());
@@ -233,7 +233,7 @@ TEST(MethodSingle, SunDiskQuadratureConverges) {
 TEST(MethodSingle, GroundReflection) {
   const TestScene& sc = Clear();
   const AtmosphereModel& m = sc.model;
-  MarchSettings s = SingleMarchSettings("high");
+  MarchSettings s = SingleMarchSettings(Quality::kHigh);
   s.disk_rings = 0;
   SingleScatteringModel model(m, s);
   const glm::dvec3 x(0, 0, m.bottom_radius_m);
@@ -255,7 +255,7 @@ TEST(MethodSingle, GroundReflection) {
 TEST(MethodSingle, EarthShadow) {
   const TestScene& sc = Clear();
   const AtmosphereModel& m = sc.model;
-  SingleScatteringModel model(m, SingleMarchSettings("medium"));
+  SingleScatteringModel model(m, SingleMarchSettings(Quality::kMedium));
   const glm::dvec3 x(0, 0, m.bottom_radius_m + 1.0);
   std::vector<double> day(m.wavelengths()), night(m.wavelengths()), ground(m.wavelengths());
   model.MarchRay(x, glm::dvec3(0, 0, 1), DirectionFromAngles(60 * kDeg, 0), {}, day.data());
@@ -269,7 +269,7 @@ TEST(MethodSingle, EarthShadow) {
 TEST(MethodSingle, DeterministicPerDirection) {
   const AtmosphereModel& m = Clear().model;
   SkyMethodOptions o;
-  o.quality = "medium";
+  o.quality = Quality::kMedium;
   std::unique_ptr<SkyMethod> method = MakeSkyMethod("single", m, o, {});
   std::vector<std::array<double, 3>> dirs = {Dir(0, 0), Dir(45, 30), Dir(89, 170), Dir(120, 0)};
   std::vector<double> a, b;

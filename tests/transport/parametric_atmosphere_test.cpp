@@ -132,7 +132,7 @@ TEST(ParametricAtmosphere, ThinSingleScatteringMatchesTheClosedForm) {
   const WavelengthGrid grid = WavelengthGrid::List({440, 550, 680});
   const AtmosphereModel m = Build(p, grid);
   SkyMethodOptions so;
-  so.quality = "high";
+  so.quality = Quality::kHigh;
   std::unique_ptr<SkyMethod> single = MakeSkyMethod("single", m, so, nullptr);
   for (double sza : {0.0, 30.0, 60.0}) {
     std::vector<double> out;

@@ -46,7 +46,7 @@ TEST(Points, OrdersAtTexelCentresAreTheRender) {
   const TestScene t = LoadTestScene("clear", so);
   const Scene scene = SceneOf(t);
   SkyMethodOptions mo;
-  mo.quality = "low";
+  mo.quality = Quality::kLow;
   const std::unique_ptr<SkyMethod> method = MakeSkyMethod("orders", scene.model, mo, nullptr);
   SkyRenderSettings rs;
   rs.mapping = MakeSkyMapping("equirectangular", 16, 8);
@@ -103,7 +103,7 @@ TEST(Points, PathAgreesWithOrdersWithinTheDocumentedFigures) {
   const PointsResult path = EvaluatePoints(scene, pp, InputOf(rows, wl), nullptr);
   PointsOptions po;
   po.method = "orders";
-  po.method_options.quality = "low";
+  po.method_options.quality = Quality::kLow;
   const PointsResult orders = EvaluatePoints(scene, po, InputOf(rows, wl), nullptr);
   for (size_t r = 0; r < rows.size(); ++r) {
     const PointResult &a = path.rows[r], &b = orders.rows[r];

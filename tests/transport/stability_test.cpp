@@ -50,7 +50,7 @@ std::vector<Ref> Path(const TestScene& sc, double sun_elevation_deg, const std::
 std::vector<double> Method(const TestScene& sc, const std::string& name, const std::string& quality, double sun_elevation_deg,
                            const std::vector<std::array<double, 3>>& dirs) {
   SkyMethodOptions o;
-  o.quality = quality;
+  o.quality = ParseQuality(quality, "quality");
   std::vector<double> L;
   MakeSkyMethod(name, sc.model, o, {})->Radiance(1.0, (90 - sun_elevation_deg) * kDeg, dirs, &L);
   std::vector<double> y;

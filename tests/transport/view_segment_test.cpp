@@ -104,7 +104,7 @@ TEST(ViewSegment, PathTracerMatchesSlabClosedForm) {
 TEST(ViewSegment, OrdersAgreesWithPathTracer) {
   const TestScene sc = LoadTestScene("clear");
   SkyMethodOptions o;
-  o.quality = "low";
+  o.quality = Quality::kLow;
   const std::unique_ptr<SkyMethod> orders = MakeSkyMethod("orders", sc.model, o, {});
   ASSERT_TRUE(orders->SupportsSegments());
   PathTracerSettings ps;
@@ -153,7 +153,7 @@ TEST(ViewSegment, OrdersAgreesWithPathTracer) {
 TEST(ViewSegment, OrdersUnlimitedSegmentIsTheSky) {
   const TestScene sc = LoadTestScene("clear");
   SkyMethodOptions o;
-  o.quality = "low";
+  o.quality = Quality::kLow;
   const std::unique_ptr<SkyMethod> orders = MakeSkyMethod("orders", sc.model, o, {});
   const std::vector<std::array<double, 3>> dirs = {Dir(0, 0), Dir(45, 90), Dir(80, 0), Dir(80, 180), Dir(88, 90)};
   for (double sun_deg : {30.0, 80.0}) {

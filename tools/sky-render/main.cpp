@@ -32,12 +32,15 @@
 #include "io/exr.h"
 #include "io/fileio.h"
 #include "io/repo_paths.h"
+#include "io/text_list.h"
 #include "lut/directions.h"
 #include "spectrum/cmf.h"
 #include "spectrum/xyz.h"
 #include "transport/budget.h"
 #include "transport/path_tracer.h"
 #include "transport/points.h"
+#include "transport/quality.h"
+#include "transport/sky_method.h"
 #include "transport/sky_render.h"
 #include "transport/sky_scene.h"
 #include "transport/sky_shard.h"
@@ -83,12 +86,28 @@ int main(int argc, char** argv) {
     sub->add_option("--depfile", depfile, "Write a Make-style depfile of every file read");
   };
 
+  // --quality: a preset name of transport/quality.h, bound to the enum.
+  auto add_quality = [](CLI::App* sub, Quality* quality, const std::string& help) {
+    sub->add_option("--quality", *quality, help + ": " + QualityNamesText())
+        ->transform(CLI::Validator(
+            [](std::string& text) {
+              const std::optional<Quality> q = FindQuality(text);
+              if (!q) return "expected " + QualityNamesText() + ", got '" + text + "'";
+              text = std::to_string(static_cast<int>(*q));
+              return std::string();
+            },
+            "", "quality"))
+        ->type_name("TEXT")
+        ->default_str(QualityName(*quality));
+  };
+  const std::vector<std::string> methods = SkyMethodNames();
+
   CLI::App* render = cli.app().add_subcommand("render", "Sky images (EXR, multi-part) for a list of sun zenith angles");
   add_scene_options(render);
   RenderOptions ro;
-  render->add_option("--method", ro.method, "Rendering method: path (the Monte-Carlo reference), single, orders, ms-approx, analytic")
+  render->add_option("--method", ro.method, "Rendering method: path (the Monte-Carlo reference), " + TextList(methods, ", "))
       ->default_val("path");
-  render->add_option("--quality", ro.method_options.quality, "Deterministic methods: low, medium or high")->default_val("medium");
+  add_quality(render, &ro.method_options.quality, "Deterministic methods");
   render->add_option("--spectral-stride", ro.method_options.spectral_stride,
                      "Deterministic methods: run on every k-th wavelength (and the last), the transfer "
                      "interpolated to the grid (docs/sky-methods.md)")
@@ -118,9 +137,8 @@ int main(int argc, char** argv) {
                      "[, observer_altitude_m or _km]")
       ->required();
   points->add_option("--wavelengths-out", po.wavelengths_nm, "Output wavelengths (nm, on the grid)")->delimiter(',')->default_str("440,550,680");
-  points->add_option("--method", po.method, "path (the Monte-Carlo reference), single, orders, ms-approx or analytic")
-      ->default_val("path");
-  points->add_option("--quality", po.method_options.quality, "Deterministic methods: low, medium or high")->default_val("medium");
+  points->add_option("--method", po.method, "path (the Monte-Carlo reference), " + TextList(methods))->default_val("path");
+  add_quality(points, &po.method_options.quality, "Deterministic methods");
   points->add_option("--spectral-stride", po.method_options.spectral_stride,
                      "Deterministic methods: run on every k-th wavelength (and the last), the transfer interpolated")
       ->default_val(1);
@@ -136,7 +154,7 @@ int main(int argc, char** argv) {
   budget->add_option("--tolerance", tolerance, "Largest acceptable relative luminance error, e.g. 1% or 0.01")->default_val("1%");
   budget->add_option("--criterion", bo.criterion, "rms or max of the error over the sky (outside a 1 deg aureole)")->default_val("rms");
   budget->add_option("--method", bo.method, "Deterministic evaluator of every item")->default_val("ms-approx");
-  budget->add_option("--quality", bo.quality, "The evaluator's quality: low, medium or high")->default_val("medium");
+  add_quality(budget, &bo.quality, "The evaluator's quality");
   budget->add_option("--sun-zenith-deg", bo.sun_zenith_deg, "Sun zenith angles (deg), comma separated")
       ->delimiter(',')->default_str("30,70,85,90,94");
   budget->add_option("--altitude-range-m", altitude_range,
@@ -148,9 +166,10 @@ int main(int argc, char** argv) {
   fog::FogRenderOptions fo;
   double cut_km = 1.0;
   std::string lut_size = "32x32", att_size = "64x64", lut_texels = "nodes", fog_shard;
-  fog->add_option("--method", fo.method, "orders (deterministic, all orders) or path (the Monte-Carlo reference)")
+  const std::string segment_methods = TextList(SegmentMethodNames(), ", ");
+  fog->add_option("--method", fo.method, segment_methods + " (deterministic, all orders) or path (the Monte-Carlo reference)")
       ->default_val("orders");
-  fog->add_option("--quality", fo.method_options.quality, "orders: low, medium or high")->default_val("medium");
+  add_quality(fog, &fo.method_options.quality, segment_methods);
   fog->add_option("--spectral-stride", fo.method_options.spectral_stride,
                   "orders: run on every k-th wavelength (and the last), the transfer interpolated (docs/sky-methods.md)")
       ->default_val(1);

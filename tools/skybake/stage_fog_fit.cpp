@@ -34,6 +34,8 @@
 #include "stage.h"
 #include "stage_helpers.h"
 #include "io/size.h"
+#include "transport/quality.h"
+#include "transport/sky_method.h"
 
 namespace skybake {
 
@@ -47,8 +49,10 @@ class FogFitStage : public Stage {
     std::optional<YamlMap> fog = root.OptionalMap("fog");
     if (!fog) return;
     enabled_ = true;
-    method_ = fog->ChoiceOr("method", {"orders", "path"}, method_);
-    quality_ = fog->ChoiceOr("quality", {"low", "medium", "high"}, quality_);
+    std::vector<std::string> methods = SegmentMethodNames();
+    methods.push_back("path");
+    method_ = fog->ChoiceOr("method", methods, method_);
+    quality_ = QualityOr(*fog, quality_);
     stride_ = static_cast<int>(fog->IntegerOr("spectral_stride", 1, 64, "a whole number from 1 to 64", stride_));
     cut_km_ = fog->NumberOr("cut_altitude_km", NumberSpec::Range(0.001, 100.0, "km"), cut_km_);
     time_mapping_ = TimeMappingOr(*fog, time_mapping_);
@@ -115,7 +119,7 @@ class FogFitStage : public Stage {
       r.variables = {{"args", fmt::format("fog --method {} --quality {} --spectral-stride {} --profiles {} --mie-dir mie --wavelengths {}:{}:{} "
                                           "--cut-altitude-km {} --lut-size {} --time-mapping {} --attenuation-size {} "
                                           "--sun-zenith-deg {} --elevations {} --azimuths-deg {} --depths {}",
-                                          method_, quality_, stride_, paths::Profiles(a->name).generic_string(),
+                                          method_, QualityName(quality_), stride_, paths::Profiles(a->name).generic_string(),
                                           FormatExact(wl.min_nm), FormatExact(wl.max_nm), FormatExact(wl.step_nm),
                                           FormatExact(cut_km_), lut_size_, time_mapping_, attenuation_size_,
                                           join(sun_zenith_deg_), elevations_, join(azimuths_deg_), depths_)}};
@@ -147,7 +151,7 @@ class FogFitStage : public Stage {
 
   bool enabled_ = false;
   std::string method_ = "orders";
-  std::string quality_ = "low";
+  Quality quality_ = Quality::kLow;
   int stride_ = 1;
   double cut_km_ = 1.0;
   std::string time_mapping_ = "gt7-quadratic";

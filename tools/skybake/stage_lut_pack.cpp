@@ -32,6 +32,9 @@
 #include "stage.h"
 #include "stage_helpers.h"
 #include "io/size.h"
+#include "io/text_list.h"
+#include "transport/quality.h"
+#include "transport/sky_method.h"
 
 namespace skybake {
 
@@ -40,8 +43,8 @@ namespace {
 struct LutSky {
   std::string atmosphere;
   std::string size;
-  std::string quality;  // the section's unless the sky names its own
-  int shards = 1;       // the section's unless the sky names its own
+  Quality quality = Quality::kMedium;  // the section's unless the sky names its own
+  int shards = 1;                      // the section's unless the sky names its own
   FileLoc loc;
 };
 
@@ -53,8 +56,8 @@ class LutPackStage : public Stage {
     std::optional<YamlMap> luts = root.OptionalMap("luts");
     if (!luts) return;
     enabled_ = true;
-    method_ = luts->ChoiceOr("method", {"orders", "single", "ms-approx", "analytic"}, method_);
-    quality_ = luts->ChoiceOr("quality", {"low", "medium", "high"}, quality_);
+    method_ = luts->ChoiceOr("method", SkyMethodNames(), method_);
+    quality_ = QualityOr(*luts, quality_);
     const double stride = luts->NumberOr("spectral_stride", NumberSpec::Range(1, 64, "wavelengths"), spectral_stride_);
     if (stride != std::floor(stride)) {
       luts->Get("spectral_stride")->ErrorExpected("a whole number of wavelengths from 1 to 64");
@@ -77,7 +80,7 @@ class LutPackStage : public Stage {
     shards_ = ShardsOr(*luts, shards_);
     std::set<std::string> seen;
     for (const YamlNode& n : luts->Seq("skies")) {
-      YamlMap m = n.ToMap("a mapping {atmosphere: NAME, size: WxH[, quality: low|medium|high]}");
+      YamlMap m = n.ToMap("a mapping {atmosphere: NAME, size: WxH[, quality: " + TextList(QualityNames(), "|", "|") + "]}");
       if (!m.valid()) continue;
       LutSky s;
       s.loc = n.loc();
@@ -85,7 +88,7 @@ class LutPackStage : public Stage {
       const std::string size = m.String("size", "WxH, e.g. 32x128");
       if (!size.empty() && !ParseSize(size, 2, 4096)) m.Get("size")->ErrorExpected(SizeExpected(2, 4096, "32x128"));
       s.size = size;
-      s.quality = m.ChoiceOr("quality", {"low", "medium", "high"}, quality_);
+      s.quality = QualityOr(m, quality_);
       s.shards = ShardsOr(m, shards_);
       if (s.shards > TimeMappingSlices(time_mapping_)) {
         (m.Has("shards") ? *m.Get("shards") : n)
@@ -133,7 +136,7 @@ class LutPackStage : public Stage {
       for (const std::string& mie : MieTableInputs(a->spec)) b.implicit_inputs.push_back(mie);
       std::string args = fmt::format("render --method {} --quality {} --profiles {} --mie-dir mie --wavelengths {}:{}:{} "
                                      "--mapping gt7 --size {} --time-mapping {}",
-                                     method_, s.quality, paths::Profiles(a->name).generic_string(),
+                                     method_, QualityName(s.quality), paths::Profiles(a->name).generic_string(),
                                      FormatExact(wl.min_nm), FormatExact(wl.max_nm), FormatExact(wl.step_nm), s.size,
                                      time_mapping_);
       if (spectral_stride_ > 1) args += fmt::format(" --spectral-stride {}", spectral_stride_);
@@ -163,7 +166,7 @@ class LutPackStage : public Stage {
  private:
   bool enabled_ = false;
   std::string method_ = "orders";
-  std::string quality_ = "medium";
+  Quality quality_ = Quality::kMedium;
   int spectral_stride_ = 1;
   std::string time_mapping_ = "gt7-quadratic";
   std::string exposure_stops_ = "auto";

@@ -17,6 +17,7 @@
 #include "fog/fog_evaluator.h"
 #include "fog/fog_shard.h"
 #include "io/error.h"
+#include "io/text_list.h"
 #include "io/yaml.h"
 #include "transport/path_tracer.h"
 #include "transport/view_segment.h"
@@ -127,8 +128,10 @@ std::vector<double> ElevationGridDeg(int m) {
 FogRender RenderFog(const Scene& scene, const FogRenderOptions& o, const ProgressFn& progress) {
   const AtmosphereModel& m = scene.model;
   if (!scene.spec.planet) throw InputError(FileLoc{scene.spec.file.string(), 0}, "fog renders need the 'planet' section");
-  if (o.method != "path" && o.method != "orders") {
-    throw UsageError("--method " + o.method + " does not render view segments (fog); use orders or path");
+  const SkyMethodEntry* entry = FindSkyMethod(o.method);
+  if (o.method != "path" && !(entry && entry->segments)) {
+    throw UsageError("--method " + o.method + " does not render view segments (fog); use " +
+                     TextList(SegmentMethodNames(), ", ") + " or path");
   }
   const double h = o.observer_altitude_m >= 0.0 ? o.observer_altitude_m : scene.spec.observer_altitude_m;
   const double top = m.top_radius_m - m.bottom_radius_m;

@@ -12,6 +12,7 @@
 
 #include "color/color.h"
 #include "io/error.h"
+#include "io/text_list.h"
 #include "transport/sky_method.h"
 
 namespace skybake {
@@ -72,11 +73,9 @@ BudgetReport RunBudget(const SceneOptions& so, const BudgetOptions& o, const Pro
   for (double z : o.sun_zenith_deg) {
     if (!(z >= 0.0 && z <= 180.0)) throw UsageError(fmt::format("--sun-zenith-deg: {} is outside 0-180", z));
   }
-  const std::vector<std::string> names = SkyMethodNames();
-  if (std::find(names.begin(), names.end(), o.method) == names.end()) {
-    std::string known;
-    for (const std::string& n : names) known += (known.empty() ? "" : ", ") + n;
-    throw UsageError("--method: the budget needs a deterministic method (" + known + "), got '" + o.method + "'");
+  if (!FindSkyMethod(o.method)) {
+    throw UsageError("--method: the budget needs a deterministic method (" + TextList(SkyMethodNames(), ", ") +
+                     "), got '" + o.method + "'");
   }
   ReportProgress(progress, "budget: baseline", 0.0);
   const Scene base = LoadScene(so, {});

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "io/progress.h"
+#include "transport/quality.h"
 #include "transport/sky_error.h"
 #include "transport/sky_scene.h"
 
@@ -35,7 +36,7 @@ namespace skybake {
 
 struct BudgetOptions {
   std::string method = "ms-approx";
-  std::string quality = "medium";
+  Quality quality = Quality::kMedium;
   double tolerance = 0.01;                  // relative
   std::string criterion = "rms";            // rms | max
   std::vector<double> sun_zenith_deg = {30, 70, 85, 90, 94};
@@ -64,7 +65,7 @@ struct BudgetReport {
   std::vector<std::filesystem::path> files_read;  // of the baseline scene (for depfiles)
 };
 
-// Throws UsageError for bad options (unknown method/quality/criterion, tolerance <= 0, an empty or
+// Throws UsageError for bad options (unknown method/criterion, tolerance <= 0, an empty or
 // out-of-range altitude range) and what LoadScene throws.
 BudgetReport RunBudget(const SceneOptions& scene, const BudgetOptions& options, const ProgressFn& progress);
 

@@ -70,24 +70,21 @@ void AnalyticSky::Radiance(const glm::dvec3& x, const glm::dvec3& v, const glm::
   }
 }
 
+const QualityTable<int>& AnalyticSteps() {
+  // low: the improved formula (one point); medium: the blog's NUM_STEPS; high: a fine march.
+  static const QualityTable<int> steps = {{0, 20, 200}};
+  return steps;
+}
+
 namespace {
 
 class AnalyticMethod : public SkyMethod {
  public:
-  AnalyticMethod(const AtmosphereModel& model, const SkyMethodOptions& o) : quality_(o.quality), sky_(model), model_(model) {
-    if (o.quality == "low") {
-      steps_ = 0;
-    } else if (o.quality == "medium") {
-      steps_ = 20;  // the blog's NUM_STEPS
-    } else if (o.quality == "high") {
-      steps_ = 200;
-    } else {
-      throw UsageError("--quality: expected low, medium or high, got '" + o.quality + "'");
-    }
-  }
+  AnalyticMethod(const AtmosphereModel& model, const SkyMethodOptions& o)
+      : quality_(o.quality), sky_(model), model_(model), steps_(AnalyticSteps()[o.quality]) {}
   std::string Name() const override { return "analytic"; }
   std::string Describe() const override {
-    return fmt::format("method: analytic\nquality: {}\nformula: {}\nsteps: {}\n", quality_,
+    return fmt::format("method: analytic\nquality: {}\nformula: {}\nsteps: {}\n", QualityName(quality_),
                        steps_ == 0 ? "improved (one point)" : "initial (march)", steps_);
   }
   void Radiance(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,
@@ -109,7 +106,7 @@ class AnalyticMethod : public SkyMethod {
   }
 
  private:
-  std::string quality_;
+  Quality quality_;
   AnalyticSky sky_;
   const AtmosphereModel& model_;
   int steps_ = 0;

@@ -61,6 +61,9 @@ class AnalyticSky {
   std::vector<const PhaseModel*> phase_;
 };
 
+// The presets: march steps along the view ray by quality (0: the improved, one-point formula).
+const QualityTable<int>& AnalyticSteps();
+
 std::unique_ptr<SkyMethod> MakeAnalyticMethod(const AtmosphereModel& model, const SkyMethodOptions& options);
 
 }  // namespace skybake

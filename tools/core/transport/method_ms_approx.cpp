@@ -20,34 +20,23 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 }
 
-MsApproxSettings MsApproxPreset(const std::string& quality) {
-  MsApproxSettings s;
-  s.march = SingleMarchSettings(quality);  // throws UsageError for an unknown quality
-  if (quality == "low") {
-    s.lut_mu_s = 16;
-    s.lut_z = 16;
-    s.sqrt_dirs = 4;
-    s.ray_dz_min_m = 1000;
-    s.ray_dz_rel = 0.5;
-    s.ray_max_piece_m = 200e3;
-  } else if (quality == "medium") {
-    // Hillaire 2020 Table 2: a 32 x 32 LUT, 64 directions, 20 samples per ray.
-    s.lut_mu_s = 32;
-    s.lut_z = 32;
-    s.sqrt_dirs = 8;
-    s.ray_dz_min_m = 300;
-    s.ray_dz_rel = 0.25;
-    s.ray_max_piece_m = 50e3;
-  } else {
-    s.lut_mu_s = 64;
-    s.lut_z = 64;
-    s.sqrt_dirs = 16;
-    s.ray_dz_min_m = 100;
-    s.ray_dz_rel = 0.1;
-    s.ray_max_piece_m = 20e3;
-  }
-  return s;
+const QualityTable<MsApproxSettings>& MsApproxPresets() {
+  // The LUT's nodes, directions and ray ladder; the view rays march as `single` at the same quality.
+  static const QualityTable<MsApproxSettings> presets = {{
+      // low
+      MsApproxSettings{.march = SingleMarchSettings(Quality::kLow), .lut_mu_s = 16, .lut_z = 16, .sqrt_dirs = 4,
+                       .ray_dz_min_m = 1000, .ray_dz_rel = 0.5, .ray_max_piece_m = 200e3},
+      // medium: Hillaire 2020 Table 2, a 32 x 32 LUT, 64 directions, 20 samples per ray.
+      MsApproxSettings{.march = SingleMarchSettings(Quality::kMedium), .lut_mu_s = 32, .lut_z = 32, .sqrt_dirs = 8,
+                       .ray_dz_min_m = 300, .ray_dz_rel = 0.25, .ray_max_piece_m = 50e3},
+      // high
+      MsApproxSettings{.march = SingleMarchSettings(Quality::kHigh), .lut_mu_s = 64, .lut_z = 64, .sqrt_dirs = 16,
+                       .ray_dz_min_m = 100, .ray_dz_rel = 0.1, .ray_max_piece_m = 20e3},
+  }};
+  return presets;
 }
+
+MsApproxSettings MsApproxPreset(Quality quality) { return MsApproxPresets()[quality]; }
 
 MultipleScatteringLut::MultipleScatteringLut(const SingleScatteringModel& ss, const MsApproxSettings& s,
                                              const ProgressFn& progress)
@@ -215,7 +204,7 @@ std::unique_ptr<SkyMethod> MakeMsApproxMethod(const AtmosphereModel& model, cons
   MsApproxSettings s = MsApproxPreset(options.quality);
   if (options.orders < 0) throw UsageError(fmt::format("--orders: expected >= 0, got {}", options.orders));
   s.orders = options.orders;
-  return std::make_unique<MsApproxMethod>(model, s, options.quality, progress);
+  return std::make_unique<MsApproxMethod>(model, s, QualityName(options.quality), progress);
 }
 
 std::unique_ptr<SkyMethod> MakeMsApproxMethod(const AtmosphereModel& model, const MsApproxSettings& settings,

@@ -52,8 +52,9 @@ struct MsApproxSettings {
   int orders = 0;             // 0: all (the geometric series); N: orders 1..N
 };
 
-// The presets by quality (UsageError for an unknown one).
-MsApproxSettings MsApproxPreset(const std::string& quality);
+// The presets, indexed by quality.
+const QualityTable<MsApproxSettings>& MsApproxPresets();
+MsApproxSettings MsApproxPreset(Quality quality);
 
 class MultipleScatteringLut : public SingleScatteringModel::ExtraSource {
  public:

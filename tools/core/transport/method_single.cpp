@@ -410,36 +410,22 @@ void SingleScatteringModel::MarchRay(const glm::dvec3& x, const glm::dvec3& v, c
 
 // ---------------------------------------------------------------------------- the method
 
-MarchSettings SingleMarchSettings(const std::string& quality) {
-  MarchSettings s;
-  if (quality == "low") {
-    s.dz_min_m = 500.0;
-    s.dz_rel = 0.3;
-    s.max_piece_m = 100e3;
-    s.disk_rings = 0;
-    s.table_mu = 64;
-    s.table_r = 16;
-  } else if (quality == "medium") {
-    s.dz_min_m = 150.0;
-    s.dz_rel = 0.12;
-    s.max_piece_m = 30e3;
-    s.disk_rings = 1;
-    s.disk_sectors = 4;
-    s.table_mu = 128;
-    s.table_r = 32;
-  } else if (quality == "high") {
-    s.dz_min_m = 50.0;
-    s.dz_rel = 0.05;
-    s.max_piece_m = 10e3;
-    s.disk_rings = 3;
-    s.disk_sectors = 6;
-    s.table_mu = 256;
-    s.table_r = 64;
-  } else {
-    throw UsageError("--quality: expected low, medium or high, got '" + quality + "'");
-  }
-  return s;
+const QualityTable<MarchSettings>& SingleMarchPresets() {
+  static const QualityTable<MarchSettings> presets = {{
+      // low: a point sun
+      MarchSettings{.dz_min_m = 500.0, .dz_rel = 0.3, .max_piece_m = 100e3, .disk_rings = 0, .disk_sectors = 4,
+                    .table_mu = 64, .table_r = 16},
+      // medium
+      MarchSettings{.dz_min_m = 150.0, .dz_rel = 0.12, .max_piece_m = 30e3, .disk_rings = 1, .disk_sectors = 4,
+                    .table_mu = 128, .table_r = 32},
+      // high
+      MarchSettings{.dz_min_m = 50.0, .dz_rel = 0.05, .max_piece_m = 10e3, .disk_rings = 3, .disk_sectors = 6,
+                    .table_mu = 256, .table_r = 64},
+  }};
+  return presets;
 }
+
+MarchSettings SingleMarchSettings(Quality quality) { return SingleMarchPresets()[quality]; }
 
 namespace {
 
@@ -456,7 +442,7 @@ class SingleMethod : public SkyMethod {
       : quality_(o.quality), ss_(model, SingleMarchSettings(o.quality)) {}
   std::string Name() const override { return "single"; }
   std::string Describe() const override {
-    return "method: single\nquality: " + quality_ + "\n" + DescribeMarch(ss_.settings());
+    return "method: single\nquality: " + QualityName(quality_) + "\n" + DescribeMarch(ss_.settings());
   }
   void Radiance(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,
                 std::vector<double>* out) const override {
@@ -479,7 +465,7 @@ class SingleMethod : public SkyMethod {
   }
 
  private:
-  std::string quality_;
+  Quality quality_;
   SingleScatteringModel ss_;
 };
 

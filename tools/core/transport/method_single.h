@@ -169,8 +169,9 @@ class SingleScatteringModel {
 // (docs/sky-methods.md lists them and their measured errors).
 std::unique_ptr<SkyMethod> MakeSingleMethod(const AtmosphereModel& model, const SkyMethodOptions& options);
 
-// The presets by quality (UsageError for an unknown quality), and their YAML for provenance.
-MarchSettings SingleMarchSettings(const std::string& quality);
+// The presets, indexed by quality, and their YAML for provenance.
+const QualityTable<MarchSettings>& SingleMarchPresets();
+MarchSettings SingleMarchSettings(Quality quality);
 std::string DescribeMarchSettings(const MarchSettings& settings);
 
 // The geometry of a ray inside the atmosphere: distance to the ground (infinity if it misses)

@@ -263,7 +263,7 @@ std::string PointsCsv(const Scene& scene, const PointsOptions& o, const PointsIn
                          : fmt::format("path tracer, target relative error {:g}, {} to {} paths per row",
                                        scene.tracer.target_relative_error, scene.tracer.min_paths, scene.tracer.max_paths))
           : fmt::format("method {}, quality {}, built once per observer altitude ({} built)", o.method,
-                        o.method_options.quality, res.methods_built);
+                        QualityName(o.method_options.quality), res.methods_built);
   std::string out = "# source: sky-render points (" + how +
                     "); relative_azimuth_deg = 0 looks towards the sun's azimuth; L/E0 = radiance per unit "
                     "extraterrestrial irradiance on a surface normal to the sun (sr^-1); single = the order-1 part; "

@@ -12,22 +12,26 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "atmosphere/model.h"
 #include "io/progress.h"
+#include "transport/quality.h"
 #include "transport/view_segment.h"
 
 namespace skybake {
 
 // Knobs common to the methods; each method documents which it reads. `quality` selects a
-// preset (low/medium/high) that the explicit numbers override when > 0.
+// preset (each method's preset table) that the explicit numbers override when > 0.
 struct SkyMethodOptions {
-  std::string quality = "medium";
+  Quality quality = Quality::kMedium;
   int view_steps = 0;        // quadrature points along a view ray
   int orders = 0;            // highest scattering order (orders: stop earlier if converged)
   double order_tolerance = 0.0;  // orders: stop when an order adds less than this fraction
-  std::map<std::string, int> table_size;  // orders: named table resolutions (docs/sky-methods.md)
+  // Expert overrides by key, read by the methods whose registry row lists the key (orders: its
+  // OrdersOverrides, docs/sky-methods.md "Expert overrides"); any other key is a UsageError.
+  std::map<std::string, int> table_size;
   // Observer altitude the tables are built for (orders puts a radius node there; other
   // altitudes are interpolated between nodes).
   double observer_altitude_m = 0.0;
@@ -65,12 +69,36 @@ class SkyMethod {
                                std::vector<double>* out) const;
 };
 
-// Builds a method by name ("single", "orders", "ms-approx", "analytic"); UsageError for an
-// unknown name or quality. May precompute (progress reported).
+// The registry of the deterministic methods (sky_method.cpp): one row per method, in the order
+// of --help. The CLI (--method), the generator's stages (luts.method, fog.method) and the budget
+// take their names from it.
+struct SkyMethodEntry {
+  const char* name;
+  // Renders view segments (SupportsSegments: fog).
+  bool segments;
+  // The expert override keys of SkyMethodOptions::table_size it reads (none: an empty list).
+  const std::vector<std::string>& (*override_keys)();
+  std::unique_ptr<SkyMethod> (*make)(const AtmosphereModel& model, const SkyMethodOptions& options,
+                                     const ProgressFn& progress);
+};
+const std::vector<SkyMethodEntry>& SkyMethodRegistry();
+// The row of a name; nullptr for an unknown one.
+const SkyMethodEntry* FindSkyMethod(std::string_view name);
+
+// Builds a method by name (a registry row); UsageError for an unknown name or a table_size key
+// the method does not read. May precompute (progress reported).
 std::unique_ptr<SkyMethod> MakeSkyMethod(const std::string& name, const AtmosphereModel& model,
                                          const SkyMethodOptions& options, const ProgressFn& progress);
 
-// The names MakeSkyMethod knows (for --help and errors).
+// The registry's names ("single", "orders", "ms-approx", "analytic"), and those of the methods
+// that render view segments ("orders").
 std::vector<std::string> SkyMethodNames();
+std::vector<std::string> SegmentMethodNames();
+
+// UsageError "<method>: unknown expert override '<key>' (known: a, b, ...)" for the first key of
+// `given` not in `known`, or "<method> reads no expert overrides, got '<key>'" when `known` is
+// empty.
+void CheckOverrideKeys(const std::string& method, const std::map<std::string, int>& given,
+                       const std::vector<std::string>& known);
 
 }  // namespace skybake

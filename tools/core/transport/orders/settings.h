@@ -1,7 +1,10 @@
-// The resolved settings of `orders`: table sizes, the quality presets, and the named expert
-// overrides of SkyMethodOptions::table_size (docs/sky-methods.md, "orders").
+// The resolved settings of `orders`: table sizes, the quality presets (a table indexed by
+// Quality), and the typed expert overrides of SkyMethodOptions::table_size (docs/sky-methods.md,
+// "orders" and "Expert overrides").
 #pragma once
 
+#include <string>
+#include <variant>
 #include <vector>
 
 #include "transport/sky_method.h"
@@ -68,11 +71,36 @@ struct OrdersSettings {
   double tail_share_max = 0.1;
   int max_orders = 40;
   double tolerance = 1e-3;
-  std::vector<double> sun_deg;  // sun zenith nodes
+  // The sun zenith nodes' spacing (SunNodes in settings.cpp): every sun_step_deg up to 80 deg,
+  // low_sun_step_deg to 90, twilight_step_deg through the low sun and twilight to 110.
+  int sun_step_deg = 10;
+  double low_sun_step_deg = 1.0;
+  double twilight_step_deg = 1.0;
+  std::vector<double> sun_deg = {};  // sun zenith nodes (SettingsFor)
 };
 
-// The preset of options.quality with options' overrides; UsageError for an unknown quality or
-// table sizes too small.
+// The presets: low, medium (the defaults above) and high.
+const QualityTable<OrdersSettings>& OrdersPresets();
+
+// One expert override: a key of SkyMethodOptions::table_size (an int) and the setting it sets.
+//   kCount   the integer setting itself, from min to max
+//   kFlag    a switch: 0 off, 1 on
+//   kScaled  a real setting given as an integer from min to max, divided by `divisor`
+//            (sun_low_step_x100 = 5 is 0.05 deg)
+struct OrdersOverride {
+  enum class Kind { kCount, kFlag, kScaled };
+  const char* key;
+  Kind kind;
+  int min, max;
+  double divisor;
+  std::variant<int OrdersSettings::*, bool OrdersSettings::*, double OrdersSettings::*> field;
+};
+// Every override orders reads, defined once (settings.cpp); the known keys derive from it.
+const std::vector<OrdersOverride>& OrdersOverrides();
+const std::vector<std::string>& OverrideKeys();
+
+// The preset of options.quality with options' overrides; UsageError for an unknown override key,
+// a value out of its range, or table sizes too small.
 OrdersSettings SettingsFor(const SkyMethodOptions& options);
 
 }  // namespace skybake::orders
