@@ -163,23 +163,14 @@ std::vector<ExrPart> MergeFogShards(const std::vector<ShardFile>& files) {
   std::vector<Shard> shards;
   for (const ShardFile& f : files) shards.push_back(IndexShard(f));
   const Shard& ref = shards.front();
-  std::map<int, const Shard*> by_index;
   for (const Shard& s : shards) {
     const FileLoc loc{s.file->path, 0};
     if (s.count != ref.count || s.slices != ref.slices || s.tables != ref.tables || s.provenance != ref.provenance) {
       throw InputError(loc, "a shard of another fog render than " + ref.file->path +
                                 " (its shard count, task counts or provenance differ)");
     }
-    if (!by_index.emplace(s.index, &s).second) {
-      throw InputError(loc, fmt::format("shard {}/{} is given twice (also {})", s.index, s.count, by_index[s.index]->file->path));
-    }
   }
-  for (int k = 0; k < ref.count; ++k) {
-    if (!by_index.count(k)) {
-      throw InputError(FileLoc{ref.file->path, 0},
-                       fmt::format("shard {}/{} of this fog render is missing from the merge's inputs", k, ref.count));
-    }
-  }
+  const std::map<int, const Shard*> by_index = ShardsByIndex(shards, "fog render");
   const size_t total = static_cast<size_t>(ref.slices + ref.tables);
   std::vector<std::pair<const Shard*, const ExrPart*>> slots(total, {nullptr, nullptr});
   const Shard* small = nullptr;

@@ -156,23 +156,14 @@ std::vector<ExrPart> MergeRenderShards(const std::vector<ShardFile>& files) {
   std::vector<Shard> shards;
   for (const ShardFile& f : files) shards.push_back(IndexShard(f));
   const Shard& ref = shards.front();
-  std::map<int, const Shard*> by_index;
   for (const Shard& s : shards) {
     const FileLoc loc{s.file->path, 0};
     if (s.count != ref.count || s.slices != ref.slices || ProvenanceOf(s) != ProvenanceOf(ref) ||
         s.owned->width != ref.owned->width) {
       throw InputError(loc, "a shard of another render than " + ref.file->path + " (its shard count, slices or provenance differ)");
     }
-    if (!by_index.emplace(s.index, &s).second) {
-      throw InputError(loc, fmt::format("shard {}/{} is given twice (also {})", s.index, s.count, by_index[s.index]->file->path));
-    }
   }
-  for (int k = 0; k < ref.count; ++k) {
-    if (!by_index.count(k)) {
-      throw InputError(FileLoc{ref.file->path, 0},
-                       fmt::format("shard {}/{} of this render is missing from the merge's inputs", k, ref.count));
-    }
-  }
+  const std::map<int, const Shard*> by_index = ShardsByIndex(shards, "render");
   // Every texel of every slice is computed by exactly one shard; texel 0's shard holds the slice's
   // ambient and table rows and its part is the base of the merged slice.
   const size_t W = static_cast<size_t>(ref.owned->width);

@@ -18,11 +18,15 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include <fmt/format.h>
+
+#include "io/error.h"
 #include "io/exr.h"
 
 namespace skybake {
@@ -50,6 +54,29 @@ struct ShardFile {
   std::string path;  // for messages
   std::vector<ExrPart> parts;
 };
+
+// The merge's inputs by shard index, each of 0 .. count - 1 exactly once. S is a merge's view of
+// one input: its `index`, `count` and `file` (a ShardFile*); the counts are already known to
+// agree. InputError at the file of a repeated index ("shard k/N is given twice (also F)") or, at
+// the first file, for a missing one ("shard k/N of this <what> is missing from the merge's inputs").
+template <typename S>
+std::map<int, const S*> ShardsByIndex(const std::vector<S>& shards, const std::string& what) {
+  std::map<int, const S*> by_index;
+  for (const S& s : shards) {
+    if (!by_index.emplace(s.index, &s).second) {
+      throw InputError(FileLoc{s.file->path, 0},
+                       fmt::format("shard {}/{} is given twice (also {})", s.index, s.count, by_index[s.index]->file->path));
+    }
+  }
+  const S& first = shards.front();
+  for (int k = 0; k < first.count; ++k) {
+    if (!by_index.count(k)) {
+      throw InputError(FileLoc{first.file->path, 0},
+                       fmt::format("shard {}/{} of this {} is missing from the merge's inputs", k, first.count, what));
+    }
+  }
+  return by_index;
+}
 
 // Joins the N shard files of one render (any order) into the parts of the unsharded render.
 // Throws InputError naming the file when a file is not a shard, belongs to another render
