@@ -182,6 +182,14 @@ class ShardedGraphTest(ReducedPipeline):
         self.edit("pipeline.yaml", "preview: true, shards: 1", "preview: true, shards: 9")  # 2 slices x 4 texel tasks
         self.generate_fails("pipeline.yaml:7: key 'sky.shards': 9 shards for 8 texel tasks of the render: at most one shard per task")
 
+    def test_no_shards_key_and_bad_sun_angles_report_the_angles(self):
+        # Without a `shards` key nothing is said of shards, even when the sun angles that count the
+        # tasks are themselves in error (tests/fuzz/regressions/pipeline_yaml/).
+        self.pipeline("pipeline.yaml", "outputs", 1)
+        self.edit("pipeline.yaml", "preview: true, shards: 1", "preview: true")
+        self.edit("pipeline.yaml", "sun_zenith_deg: [40, 85], target_error", "sun_zenith_deg: [40, gg85], target_error")
+        self.generate_fails("pipeline.yaml:7: key 'sky.sun_zenith_deg[1]'")
+
     def test_a_missing_launcher_fails_at_generate_time(self):
         self.pipeline("pipeline.yaml", "outputs", 2, 'launchers: {sky-render: "no-such-srun --quiet -n1"}\n')
         self.generate_fails("pipeline.yaml:7: key 'launchers.sky-render': 'no-such-srun' is not on PATH")

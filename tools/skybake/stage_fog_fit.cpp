@@ -73,7 +73,7 @@ class FogFitStage : public Stage {
     shards_ = ShardsOr(*fog, shards_);
     // A fog render's shard task is a LUT slice or a depth table (fog/fog_shard.h).
     const int tasks = TimeMappingSlices(time_mapping_) + static_cast<int>(sun_zenith_deg_.size());
-    if (shards_ > tasks) {
+    if (fog->Has("shards") && shards_ > tasks) {
       fog->Get("shards")->Error(fmt::format("{} shards for the {} LUT slices of time mapping {} and {} depth tables: at "
                                             "most one shard per slice or table",
                                             shards_, TimeMappingSlices(time_mapping_), time_mapping_,

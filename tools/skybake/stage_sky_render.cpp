@@ -56,7 +56,7 @@ class SkyRenderStage : public Stage {
     // A path render's shard task is a texel of a slice, at least one per mirror pair of texels.
     const std::optional<Size2> grid = ParseSize(size_, 2, 8192);
     const size_t tasks = sun_zenith_deg_.size() * (grid ? static_cast<size_t>(grid->width) * grid->height / 2 : 1);
-    if (static_cast<size_t>(shards_) > tasks) {
+    if (sky->Has("shards") && static_cast<size_t>(shards_) > tasks) {
       sky->Get("shards")->Error(fmt::format("{} shards for {} texel tasks of the render: at most one shard per task", shards_, tasks));
     }
     if (std::optional<std::vector<YamlNode>> only = sky->OptionalSeq("atmospheres")) {
