@@ -14,6 +14,19 @@ import zlib
 BIN = os.environ.get("SKYBAKE_BIN_DIR", os.path.join(os.path.dirname(__file__), "..", "..", "build", "dev", "bin"))
 SRC = os.environ.get("SKYBAKE_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
 
+# A one-mode water particle type small enough for a reduced pipeline's Mie table (seconds).
+TINY_PARTICLE = """refractive_index:
+  table: ../atmospheres/data/water_refractive_index_segelstein_1981.csv
+modes:
+  - name: small
+    basis: number
+    median_radius_um: 0.1
+    sigma_g: 1.5
+    r_min_um: 0.02
+    r_max_um: 0.5
+    weight: {relative_number: 1.0}
+"""
+
 
 def tool(name):
     return os.path.join(BIN, name)

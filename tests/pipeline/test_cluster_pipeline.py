@@ -24,7 +24,7 @@ import time
 import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "cli"))
-from skytest import SRC, PipelineTestCase, run, tool  # noqa: E402
+from skytest import SRC, PipelineTestCase, TINY_PARTICLE, run, tool  # noqa: E402
 
 PIPELINE = """outputs: {outputs}
 altitude_step_m: 200
@@ -52,18 +52,6 @@ FOG = """fog:
   depth_tables: {{sun_zenith_deg: [40, 85], elevations: 5, azimuths_deg: [0, 90, 180], depths: 8}}
   shards: {shards}
   skies: [clear, hazed]
-"""
-
-TINY_PARTICLE = """refractive_index:
-  table: ../atmospheres/data/water_refractive_index_segelstein_1981.csv
-modes:
-  - name: small
-    basis: number
-    median_radius_um: 0.1
-    sigma_g: 1.5
-    r_min_um: 0.02
-    r_max_um: 0.5
-    weight: {relative_number: 1.0}
 """
 
 SLURM_BINARIES = ("munged", "slurmctld", "slurmd", "srun", "sinfo", "squeue", "scancel")

@@ -24,7 +24,7 @@ import sys
 import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "cli"))
-from skytest import SRC, PipelineTestCase, run, tool  # noqa: E402
+from skytest import SRC, PipelineTestCase, TINY_PARTICLE, run, tool  # noqa: E402
 
 GOLDEN = os.path.join(SRC, "tests", "lut", "golden")
 
@@ -46,18 +46,6 @@ luts:
     - {atmosphere: clear, size: 4x8}
     - {atmosphere: hazed, size: 4x8}
     - {atmosphere: cloudy2, size: 2x4}
-"""
-
-TINY_PARTICLE = """refractive_index:
-  table: ../atmospheres/data/water_refractive_index_segelstein_1981.csv
-modes:
-  - name: small
-    basis: number
-    median_radius_um: 0.1
-    sigma_g: 1.5
-    r_min_um: 0.02
-    r_max_um: 0.5
-    weight: {relative_number: 1.0}
 """
 
 TEXTURES = ["sky_clear.ktx2", "sky_hazed.ktx2", "sky_cloudy2.ktx2", "transmittance.ktx2", "sun.ktx2", "ambient.ktx2"]

@@ -12,7 +12,7 @@ import sys
 import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "cli"))
-from skytest import SRC, PipelineTestCase, TempDirTestCase, run, tool  # noqa: E402
+from skytest import SRC, PipelineTestCase, TINY_PARTICLE, TempDirTestCase, run, tool  # noqa: E402
 
 PIPELINE = """outputs: outputs
 altitude_step_m: 100
@@ -27,18 +27,6 @@ sky: {size: 4x2, sun_zenith_deg: [40], target_error: 0.5, preview: false}
 
 # A cheap particle type for the pipeline tests (small droplets: few Mie terms), replacing the
 # atmospheres' real types so that a bake takes seconds. Both atmospheres share it: one Mie edge.
-TINY_PARTICLE = """refractive_index:
-  table: ../atmospheres/data/water_refractive_index_segelstein_1981.csv
-modes:
-  - name: small
-    basis: number
-    median_radius_um: 0.1
-    sigma_g: 1.5
-    r_min_um: 0.02
-    r_max_um: 0.5
-    weight: {relative_number: 1.0}
-"""
-
 
 def edges_run(ninja_stdout):
     """The descriptions of the edges ninja ran ("[1/2] profile-import x" -> "profile-import x")."""
