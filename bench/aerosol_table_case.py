@@ -3,7 +3,7 @@
 particles/gt7_case_study.yaml sampled as dV/d ln r at AERONET's 22 radii (0.05-15 um), built
 "as is" as a tabulated type, against the modes (docs/mie.md, "The case study: modes against a table").
 
-  python3 bench/aerosol_table_case.py --bin build/release/bin [--write-shipped] [--rows 22]
+  python3 bench/aerosol_table_case.py --bin build/release/bin [--write-shipped] [--rows 22] [--sky]
 
 --write-shipped writes particles/data/gt7_case_study_22_bins.csv (the table the shipped type
 particles/gt7_case_study_22_bins.yaml reads). Otherwise the script writes the table for --rows
@@ -12,6 +12,10 @@ radii to a temporary folder, builds both Mie tables on the pipeline's grid (360-
 volume, of the albedo and of g; the phase function's largest relative difference and its L1
 distance; and the single-scattering aerosol sky per unit optical depth, omega P(theta), at
 5, 30, 90 and 150 degrees - the table against the modes, in per cent. Numbers, not a pass/fail.
+--sky also renders the sky of atmospheres/clear.yaml with each of the two as its aerosol (optical
+depth 0.3 at 550 nm) by `sky-render points --method orders` (all orders of scattering, Rayleigh
+and ozone included) on the almucantar of a sun at 60 degrees zenith and at the zenith, and prints
+the radiance's relative difference, per cent.
 
 The density of the modes (particle_type.h): each mode i is a volume log-normal of median r_V,i and
 s_i = ln sigma_g, normalised to its volume inside [0.05, 15] um and weighted by its relative
@@ -78,11 +82,43 @@ def Dump(bin_dir, exr, what, wl=None):
     return list(csv.DictReader(line for line in io.StringIO(text) if not line.startswith("#")))
 
 
+SKY_AZIMUTHS_DEG = [5, 10, 30, 60, 90, 120, 180]
+
+
+def Sky(bin_dir, tmp, mie_dir, names):
+    """Radiance at 450/550/650 nm per geometry for each particle type name (clear.yaml's air)."""
+    with open(os.path.join(ROOT, "atmospheres", "clear.yaml")) as f:
+        clear = f.read()
+    data = os.path.join(ROOT, "atmospheres", "data") + "/"
+    geo = os.path.join(tmp, "geometry.csv")
+    with open(geo, "w") as f:
+        f.write("# source: the almucantar of a sun at 60 degrees zenith, and the zenith\n"
+                "sun_zenith_deg,view_zenith_deg,relative_azimuth_deg\n")
+        for az in SKY_AZIMUTHS_DEG:
+            f.write("60,60,%d\n" % az)
+        f.write("60,0,0\n")
+    out = {}
+    for name in names:
+        text = clear.replace("file: data/", "file: " + data)
+        text = text.replace("particle: ../particles/continental.yaml", "particle: %s.yaml" % name)
+        text = text.replace("optical_depth_550nm: 0.1", "optical_depth_550nm: 0.3")
+        atm = os.path.join(tmp, "sky_%s.yaml" % name)
+        with open(atm, "w") as f:
+            f.write(text)
+        csv_out = os.path.join(tmp, "sky_%s.csv" % name)
+        subprocess.run([os.path.join(bin_dir, "sky-render"), "points", atm, "--mie-dir", mie_dir, "--geometry", geo,
+                        "-o", csv_out, "--method", "orders", "--wavelengths-out", "450,550,650", "--quiet"], check=True)
+        with open(csv_out) as f:
+            out[name] = list(csv.DictReader(line for line in f if not line.startswith("#")))
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--bin", default=os.path.join(ROOT, "build", "release", "bin"))
     ap.add_argument("--rows", type=int, default=22)
     ap.add_argument("--write-shipped", action="store_true")
+    ap.add_argument("--sky", action="store_true")
     a = ap.parse_args()
     if a.write_shipped:
         with open(os.path.join(ROOT, "particles", "data", "gt7_case_study_22_bins.csv"), "w") as f:
@@ -95,7 +131,7 @@ def main():
     with open(os.path.join(tmp, "gt7_table.yaml"), "w") as f:
         f.write("refractive_index: {table: %s}\nmodes:\n  - name: measured\n    size_table: table.csv\n"
                 "    weight: {relative_volume: 1.0}\n" % water)
-    modes_exr, table_exr = os.path.join(tmp, "modes.exr"), os.path.join(tmp, "table.exr")
+    modes_exr, table_exr = os.path.join(tmp, "gt7_case_study.exr"), os.path.join(tmp, "gt7_table.exr")
     Build(a.bin, os.path.join(ROOT, "particles", "gt7_case_study.yaml"), modes_exr)
     Build(a.bin, os.path.join(tmp, "gt7_table.yaml"), table_exr)
     sm, st = Dump(a.bin, modes_exr, "spectral"), Dump(a.bin, table_exr, "spectral")
@@ -129,6 +165,22 @@ def main():
             sky.append((float(rt["ssa"]) * float(pt[j]["phase_sr"])) / (float(rm["ssa"]) * float(pm[j]["phase_sr"])) - 1.0)
         print("%5d  %+7.3f  %+7.3f  %+7.3f  %6.3f  %6.3f  %+7.3f  %+7.3f  %+7.3f  %+7.3f" %
               (wl, 100 * csca_v, 100 * dssa, 100 * dg, 100 * dmax, 100 * l1, *(100 * v for v in sky)))
+    if a.sky:
+        # sky-render finds a type's table as <mie-dir>/<name>.exr; the atmospheres name the YAMLs.
+        for name in ("gt7_case_study", "gt7_table"):
+            src = os.path.join(ROOT, "particles", "gt7_case_study.yaml") if name == "gt7_case_study" else None
+            if src:
+                with open(src) as f, open(os.path.join(tmp, name + ".yaml"), "w") as g:
+                    g.write(f.read().replace("../atmospheres/data/", os.path.join(ROOT, "atmospheres", "data") + "/"))
+        rows = Sky(a.bin, tmp, tmp, ["gt7_case_study", "gt7_table"])
+        print("sky of clear.yaml with optical depth 0.3: table against modes, per cent (orders)")
+        print("view                      450nm    550nm    650nm")
+        for i, r in enumerate(rows["gt7_case_study"]):
+            t = rows["gt7_table"][i]
+            label = "zenith" if float(r["view_zenith_deg"]) == 0 else "almucantar az %s" % r["relative_azimuth_deg"]
+            print("%-24s" % label + "".join("  %+7.3f" % (100 * (float(t["radiance_%dnm_W_m2_sr_nm" % wl]) /
+                                                                  float(r["radiance_%dnm_W_m2_sr_nm" % wl]) - 1.0))
+                                             for wl in (450, 550, 650)))
 
 
 if __name__ == "__main__":
