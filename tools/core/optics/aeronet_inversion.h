@@ -2,7 +2,9 @@
 // "Combined Dubovik Retrievals, ALL POINTS DATA"), as `mie-tables import-aeronet` reads it
 // (docs/mie.md, "Importing an AERONET inversion").
 //
-// Layout (AERONET's download files, units at aeronet.gsfc.nasa.gov/new_web/units.html):
+// Layout (AERONET's Version 2 download files, units at aeronet.gsfc.nasa.gov/new_web/units.html;
+// a published example: the Level 2.0 combined file of Chilbolton, 10 October 2005, in
+// gist.github.com/robintw/1958483):
 //   line 1  dd:mm:yyyy,Locations=<site>,long=..,lat=..,elev=..,Nmeas=..,PI=..,Email=..
 //   line 2  Level 2.0 Almucantar Retrievals, Version 2        (or Level 1.5)
 //   line 3  Combined Dubovik Retrievals,ALL POINTS DATA,Inversion Product UNITS can be found at,...
