@@ -155,6 +155,100 @@ class MieTablesCli(CliContract, TempDirTestCase):
         p, err = self.bad(GOOD_TYPE.replace("    basis: volume\n", "    basis: volume\n    mean_radius_um: 1\n"))
         self.assertEqual(err, "mie-tables: %s:5: unknown key 'modes[0].mean_radius_um' (did you mean 'median_radius_um'?)\n" % p)
 
+    def test_bad_size_table_is_reported_with_file_and_line(self):
+        table = self.write("fine.csv", "# source: test\nradius_um,dV_dlnr_um3_um2\n0.05,0.1\n0.3,-999\n15,0.01\n")
+        p, err = self.bad("refractive_index: {n: 1.33}\nmodes:\n  - name: fine\n    size_table: fine.csv\n"
+                          "    weight: {relative_volume: 1.0}\n")
+        self.assertEqual(err, "mie-tables: %s:4: column 'dV_dlnr_um3_um2': a density must be a finite number >= 0, "
+                              "got -999 (AERONET's fill value: a missing retrieval)\n" % table)
+        self.write("fine.csv", "# source: test\nradius_um,density\n0.05,0.1\n15,0.01\n")
+        p, err = self.bad("refractive_index: {n: 1.33}\nmodes:\n  - name: fine\n    size_table: fine.csv\n"
+                          "    weight: {relative_volume: 1.0}\n")
+        self.assertTrue(err.startswith("mie-tables: %s:2: expected exactly one density column" % table), err)
+        p, err = self.bad("refractive_index: {n: 1.33}\nmodes:\n  - name: fine\n    size_table: fine.csv\n"
+                          "    r_min_um: 0.1\n    weight: {relative_volume: 1.0}\n")
+        self.assertEqual(err, "mie-tables: %s:5: key 'modes[0].r_min_um': not used with size_table (the table gives "
+                              "the distribution and its radii); remove r_min_um\n" % p)
+
+    # ---- import-aeronet
+
+    AERONET = os.path.join(SRC, "tests", "cli", "data", "aeronet_v2_synthetic.csv")
+
+    def import_aeronet(self, source, *extra, expect=0):
+        out = self.path("site.yaml")
+        r = run([tool("mie-tables"), "import-aeronet", source, "-o", out] + list(extra))
+        self.assertEqual(r.returncode, expect, r.stderr)
+        if expect != 0:
+            self.assertEqual([n for n in os.listdir(self.tmp) if n.startswith("site")], [])
+        return r
+
+    def test_import_aeronet_writes_a_type_that_builds_and_its_layer_scale(self):
+        self.import_aeronet(self.AERONET, "--row", "1")
+        with open(self.path("site_size_distribution.csv")) as f:
+            rows = list(csv.reader(line for line in f if not line.startswith("#")))
+        self.assertEqual(rows[0], ["radius_um", "dV_dlnr_um3_um2"])
+        self.assertEqual(len(rows), 23)
+        self.assertEqual(rows[1][0], "0.05")
+        self.assertEqual(rows[22][0], "15")
+        with open(self.path("site.layer.yaml")) as f:
+            layer = f.read()
+        aod550 = float(layer.split("optical_depth_550nm: ")[1].rstrip("}\n"))
+        self.assertAlmostEqual(aod550, 0.42 * (550.0 / 441.0) ** -1.85, delta=1e-6)
+        with open(self.path("site.yaml")) as f:
+            text = f.read()
+        self.assertIn("points: {wavelength_nm: [441, 675, 871, 1020], n: [1.43, 1.44, 1.45, 1.46], "
+                      "k: [0.008, 0.0065, 0.006, 0.0058]}", text)
+        self.assertIn("Synthetic_Site, 01:07:2005 13:00:05 UTC (aeronet_v2_synthetic.csv line 5)", text)
+        out = self.path("site.exr")
+        r = run([tool("mie-tables"), "build", self.path("site.yaml"), "-o", out] + GRID)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(self.path("site.report.json")) as f:
+            report = json.load(f)
+        self.assertEqual(report["modes"][0]["size_table_rows"], 22)
+        # Same input, same bytes.
+        with open(self.path("site.yaml"), "rb") as f:
+            before = f.read()
+        self.import_aeronet(self.AERONET, "--row", "1")
+        with open(self.path("site.yaml"), "rb") as f:
+            self.assertEqual(f.read(), before)
+
+    def test_import_aeronet_bad_input_is_located_and_writes_nothing(self):
+        with open(self.AERONET) as f:
+            lines = f.read().splitlines()
+        header = lines[3].split(",")
+        # Several retrievals and no --row: a usage error.
+        r = self.import_aeronet(self.AERONET, expect=2)
+        self.assertIn("--row: %s holds 2 retrievals (lines 5-6); choose one with --row 1..2" % self.AERONET, r.stderr)
+        # A non-spherical retrieval.
+        r = self.import_aeronet(self.AERONET, "--row", "2", expect=1)
+        self.assertEqual(r.stderr, "mie-tables: %s:6: column '%%sphericity': 76.2 %% of the particles are spherical, "
+                                   "below 95 %%: the retrieval models the rest as spheroids, which Mie spheres do not "
+                                   "represent\n" % self.AERONET)
+        # A fill value in a size bin and in REFI(675).
+        cells = lines[4].split(",")
+        cells[header.index("0.148184")] = "-999."
+        cells[header.index("REFI(675)")] = "-999."
+        bad = self.write("fill.csv", "\n".join(lines[:4] + [",".join(cells)]) + "\n")
+        r = self.import_aeronet(bad, expect=1)
+        self.assertEqual(r.stderr, "mie-tables: %s:5: column '0.148184': -999, AERONET's fill value: this retrieval has no "
+                                   "such value\nmie-tables: %s:5: column 'REFI(675)': -999, AERONET's fill value: this "
+                                   "retrieval has no such value\n" % (bad, bad))
+        # A missing column and a missing size bin.
+        names = [n for n in header if n not in ("%sphericity", "15.000000")]
+        keep = [header.index(n) for n in names]
+        row = [lines[4].split(",")[i] for i in keep]
+        bad = self.write("cols.csv", "\n".join(lines[:3] + [",".join(names), ",".join(row)]) + "\n")
+        r = self.import_aeronet(bad, expect=1)
+        self.assertEqual(r.stderr, "mie-tables: %s:4: expected the 22 size-distribution columns 0.050000 ... 15.000000 "
+                                   "(radius in um), found 21\nmie-tables: %s:4: missing column %%sphericity\n" % (bad, bad))
+        # Not an inversion file.
+        bad = self.write("other.csv", "a,b\nLevel 2.0 AOD\nx\ny\n1,2\n")
+        r = self.import_aeronet(bad, expect=1)
+        self.assertEqual(r.stderr, "mie-tables: %s:1: expected the site line 'dd:mm:yyyy,Locations=<site>,...'\n" % bad)
+        # A bad output name is a usage error.
+        r = run([tool("mie-tables"), "import-aeronet", self.AERONET, "--row", "1", "-o", self.path("Bad-Name.yaml")])
+        self.assertEqual(r.returncode, 2)
+
     def test_wavelength_outside_the_index_table(self):
         p, err = self.bad(GOOD_TYPE, ["--wavelength-min-nm", "250", "--wavelength-max-nm", "850", "--wavelength-step-nm", "100"])
         water = os.path.join(SRC, "atmospheres", "data", "water_refractive_index_segelstein_1981.csv")

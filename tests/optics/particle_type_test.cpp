@@ -83,7 +83,7 @@ TEST(ParticleType, LogNormalAlgebraMatchesNumericalMoments) {
   TempDir dir;
   dir.Write("index.csv", kIndexCsv);
   const ParticleType t = LoadParticleType(dir.Write("t.yaml", Type(kGoodMode)));
-  const LogNormalMode& m = t.modes[0];
+  const SizeMode& m = t.modes[0];
   const double s = 0.45;
   EXPECT_NEAR(m.NumberMedianRadiusUm(), 0.12 * std::exp(-3.0 * s * s), 1e-15);
   EXPECT_NEAR(m.VolumeMedianRadiusUm(), 0.12, 1e-15);
@@ -262,7 +262,7 @@ TEST(ParticleType, CanonicalYamlIsStableAndLoadsBack) {
 
 // The shipped types load, cover the pipeline's grid, and have the documented derived values.
 TEST(ParticleType, ShippedTypesLoad) {
-  for (const char* name : {"gt7_case_study", "continental", "water_cloud"}) {
+  for (const char* name : {"gt7_case_study", "continental", "water_cloud", "gt7_case_study_22_bins"}) {
     SCOPED_TRACE(name);
     const ParticleType t = LoadParticleType(fs::path(SKYBAKE_SOURCE_DIR) / "particles" / (std::string(name) + ".yaml"));
     EXPECT_NO_THROW(CheckWavelengthCoverage(t, 360.0, 830.0));

@@ -104,7 +104,7 @@ TEST(Polydisperse, RefinementConvergesToTheStatedTolerance) {
   const ParticleType t = TypeFromText("modes:\n" + Mode("water", 1.0, 0.4, 0.05, 15.0, "{n: 1.333, k: 2e-9}") +
                                       Mode("soot", 0.05, 0.7, 0.005, 20.0, "{n: 1.75, k: 0.44}"));
   const PhaseTables pt = MakePhaseTables(StandardPhaseGrid(), 300);
-  for (const LogNormalMode& mode : t.modes) {
+  for (const SizeMode& mode : t.modes) {
     SCOPED_TRACE(mode.name);
     const Complex m = mode.index.At(600.0);
     QuadratureOptions o;

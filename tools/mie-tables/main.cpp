@@ -7,6 +7,9 @@
 //       the Mie table of a particle type (optics/mie_table.h) and its report
 //   mie-tables dump TABLE.exr --what spectral|phase [--wavelength-nm 550] [-o out.csv]
 //       a table as CSV (for charts and for reading without an EXR library)
+//   mie-tables import-aeronet FILE -o NAME.yaml [--row N] [--min-sphericity-percent 95] [--layer L.yaml]
+//       a particle type (YAML and size-table CSV) and the aerosol-layer scale of one AERONET
+//       almucantar inversion retrieval (optics/aeronet_inversion.h)
 #include <fmt/format.h>
 
 #include <chrono>
@@ -20,6 +23,8 @@
 #include "io/exr.h"
 #include "io/fileio.h"
 #include "io/yaml.h"
+#include "import_aeronet.h"
+#include "optics/aeronet_inversion.h"
 #include "optics/mie_sphere.h"
 #include "optics/mie_table.h"
 #include "optics/particle_type.h"
@@ -89,6 +94,15 @@ std::vector<double> WavelengthGrid(double min_nm, double max_nm, double step_nm)
   return v;
 }
 
+// A type's name is its file stem: a lowercase identifier (docs/mie.md, "Valid ranges").
+bool IsTypeName(const std::string& s) {
+  if (s.empty() || s.size() > 64 || !(s[0] >= 'a' && s[0] <= 'z')) return false;
+  for (char c : s) {
+    if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_')) return false;
+  }
+  return true;
+}
+
 void WriteText(const std::string& path, const std::string& text) {
   if (path.empty() || path == "-") {
     std::cout << text;
@@ -97,13 +111,37 @@ void WriteText(const std::string& path, const std::string& text) {
   }
 }
 
+// import-aeronet: reads and checks the retrieval, then writes the type, its size table and the
+// layer scale (all inside the tool's output transaction: nothing is written on an error).
+void RunImportAeronet(ToolCli& cli, const std::string& aeronet_file, const std::string& import_out,
+                      const std::string& layer_out, int import_row, double min_sphericity) {
+  const fs::path out(import_out);
+  const std::string name = out.stem().string();
+  if (out.extension() != ".yaml" || !IsTypeName(name)) {
+    throw UsageError("--output '" + import_out + "': expected NAME.yaml with NAME a lowercase identifier (a-z, 0-9, "
+                     "_; starting with a letter): the type is named by its file");
+  }
+  mie::AeronetReadOptions options;
+  if (import_row > 0) options.row = import_row;
+  options.min_sphericity_percent = min_sphericity;
+  const mie::AeronetRetrieval r = mie::ReadAeronetRetrieval(aeronet_file, options);
+  const std::string csv_name = name + "_size_distribution.csv";
+  const mietool::ImportedType t = mietool::ImportAeronet(r, name, csv_name);
+  WriteFileIfChanged(out, t.particle_yaml);
+  WriteFileIfChanged(out.parent_path() / csv_name, t.size_csv);
+  WriteFileIfChanged(layer_out.empty() ? out.parent_path() / (name + ".layer.yaml") : fs::path(layer_out), t.layer_yaml);
+  cli.Info(fmt::format("wrote {} ({} line {}, {} {}; optical depth {:.4g} at 550 nm)", import_out, aeronet_file,
+                       r.line, r.date, r.time, r.AodAt550()));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   ToolCli cli("mie-tables",
               "Aerosol optics from Mie theory: single spheres, and per-wavelength tables of cross sections,\n"
               "albedo, asymmetry and phase function (with its CDF and fitted HG / Cornette-Shanks / dual-lobe\n"
-              "models) for the log-normal modes of a particle type. See docs/mie.md.");
+              "models) for the modes (log-normal or tabulated) of a particle type, and particle types from AERONET\n"
+              "inversions. See docs/mie.md.");
   CLI::App& app = cli.app();
   app.require_subcommand(1);
 
@@ -147,7 +185,28 @@ int main(int argc, char** argv) {
   dump->add_option("--wavelength-nm", dump_wl, "Tabulated wavelength for --what phase, nm");
   dump->add_option("-o,--output", dump_out, "Output CSV (default: stdout)");
 
+  // import-aeronet
+  CLI::App* import_cmd = app.add_subcommand("import-aeronet", "A particle type and layer scale from an AERONET inversion");
+  import_cmd->fallthrough();
+  std::string aeronet_file, import_out, layer_out;
+  int import_row = 0;
+  double min_sphericity = 95.0;
+  import_cmd->add_option("file", aeronet_file, "AERONET Version 2 almucantar inversion (Level 1.5/2.0, all points, CSV)")
+      ->required();
+  import_cmd->add_option("-o,--output", import_out, "Particle type to write, NAME.yaml (NAME_size_distribution.csv beside it)")
+      ->required();
+  import_cmd->add_option("--row", import_row, "Retrieval to import, 1 = the first line after the column names")
+      ->check(CLI::PositiveNumber);
+  import_cmd->add_option("--min-sphericity-percent", min_sphericity,
+                     "Refuse a retrieval with fewer spherical particles than this, % (default 95)")
+      ->check(CLI::Range(0.0, 100.0));
+  import_cmd->add_option("--layer", layer_out, "Aerosol-layer scale to write (default: NAME.layer.yaml beside the type)");
+
   return cli.Run(argc, argv, [&] {
+    if (import_cmd->parsed()) {
+      RunImportAeronet(cli, aeronet_file, import_out, layer_out, import_row, min_sphericity);
+      return;
+    }
     if (sphere->parsed()) {
       const std::complex<double> m = ParseIndex(m_text);
       std::vector<double> mu;

@@ -69,7 +69,21 @@ std::string BuildReportJson(const mie::ParticleType& type, const mie::MieBuild& 
   s += "  \"mean_particle_volume_m3\": " + Num(t.mean_particle_volume_m3) + ",\n";
   s += "  \"modes\": [";
   for (size_t i = 0; i < type.modes.size(); ++i) {
-    const mie::LogNormalMode& m = type.modes[i];
+    const mie::SizeMode& m = type.modes[i];
+    if (m.IsTable()) {
+      // A tabulated mode: the table's own moments (r_eff = <r^3>/<r^2>, v_eff = <r^4><r^2>/<r^3>^2 - 1).
+      const mie::SizeTable& tb = *m.table;
+      const double m2 = tb.MomentUm(2), m3 = tb.MomentUm(3), m4 = tb.MomentUm(4);
+      s += fmt::format(
+          "{}\n    {{\"name\": {}, \"number_fraction\": {}, \"size_table\": {}, \"size_table_basis\": {}, "
+          "\"size_table_rows\": {}, \"effective_radius_um\": {}, \"effective_variance\": {}, \"mean_radius_um\": {}, "
+          "\"r_min_um\": {}, \"r_max_um\": {}, \"mean_volume_inside_um3\": {}, \"refractive_index\": {}}}",
+          i ? "," : "", Quote(m.name), Num(f[i]), Quote(tb.file.filename().string()),
+          Quote(tb.basis == mie::SizeBasis::kVolume ? "volume" : "number"), tb.ln_r_um.size(), Num(m3 / m2),
+          Num(m4 * m2 / (m3 * m3) - 1.0), Num(tb.MomentUm(1)), Num(m.r_min_um), Num(m.r_max_um),
+          Num(m.MeanVolumeInsideUm3()), Quote(m.index.Describe()));
+      continue;
+    }
     s += fmt::format(
         "{}\n    {{\"name\": {}, \"number_fraction\": {}, \"number_median_radius_um\": {}, "
         "\"volume_median_radius_um\": {}, \"effective_radius_um\": {}, \"effective_variance\": {}, "

@@ -50,6 +50,57 @@ NumberSpec Weight() {
 constexpr WeightKind kWeightKinds[] = {WeightKind::kNumberDensityCm3, WeightKind::kRelativeNumber,
                                        WeightKind::kVolumeUm3PerCm3, WeightKind::kRelativeVolume};
 
+// The centre, width and truncation of a log-normal mode.
+void ParseLogNormalShape(YamlMap& m, SizeMode& mode) {
+  // Centre.
+  const std::string centre = m.ExactlyOneOf({"median_radius_um", "effective_radius_um"});
+  if (centre == "median_radius_um") {
+    mode.median_radius_um = m.Number(centre, NumberSpec::Range(1e-4, 100.0, "um"), 1.0);
+    const std::string b = m.Choice("basis", {"number", "volume"});
+    if (!b.empty()) mode.basis = b == "number" ? SizeBasis::kNumber : SizeBasis::kVolume;
+    if (!mode.basis) mode.basis = SizeBasis::kNumber;  // (reported above)
+  } else if (centre == "effective_radius_um") {
+    mode.effective_radius_um = m.Number(centre, NumberSpec::Range(1e-4, 100.0, "um"), 1.0);
+    if (std::optional<YamlNode> b = m.Get("basis")) {
+      b->Error("not used with effective_radius_um (r_eff = <r^3>/<r^2> does not depend on the basis); remove it");
+    }
+  } else {
+    m.Known({"basis"});
+  }
+  // Width.
+  const std::string width = m.ExactlyOneOf({"sigma_g", "ln_sigma_g"});
+  if (width == "sigma_g") {
+    mode.width_is_sigma_g = true;
+    mode.width_value = m.Number(width, SigmaG(), 2.0);
+  } else if (width == "ln_sigma_g") {
+    mode.width_value = m.Number(width, LnSigmaG(), 0.5);
+  } else {
+    mode.width_value = 0.5;
+  }
+  // Truncation.
+  mode.r_min_um = m.Number("r_min_um", NumberSpec::Range(1e-4, 100.0, "um"), 0.0);
+  mode.r_max_um = m.Number("r_max_um", NumberSpec::Range(1e-4, 100.0, "um"), 0.0);
+  if (mode.r_min_um > 0.0 && mode.r_max_um > 0.0 && !(mode.r_max_um > mode.r_min_um)) {
+    m.Get("r_max_um")->Error(fmt::format("must be greater than r_min_um ({} <= {})", FormatExact(mode.r_max_um),
+                                         FormatExact(mode.r_min_um)));
+  }
+}
+
+// A tabulated mode: the table gives the shape and the radius range; the log-normal keys are errors.
+void ParseSizeTableKey(YamlMap& m, const YamlNode& st, SizeMode& mode) {
+  SizeTable table;
+  table.loc = st.loc();
+  if (std::optional<std::filesystem::path> p = m.Path("size_table")) table.file = *p;
+  for (const char* key : {"basis", "median_radius_um", "effective_radius_um", "sigma_g", "ln_sigma_g",
+                          "r_min_um", "r_max_um"}) {
+    if (std::optional<YamlNode> n = m.Get(key)) {
+      n->Error(std::string("not used with size_table (the table gives the distribution and its radii); remove ") +
+               key);
+    }
+  }
+  mode.table = std::move(table);
+}
+
 }  // namespace
 
 const char* WeightKey(WeightKind kind) {
@@ -68,31 +119,36 @@ bool IsVolumeWeight(WeightKind kind) {
 
 // ---------------------------------------------------------------------------- log-normal algebra
 
-double LogNormalMode::LnSigma() const { return width_is_sigma_g ? std::log(width_value) : width_value; }
+double SizeMode::LnSigma() const {
+  SKYBAKE_CHECK(!IsTable());
+  return width_is_sigma_g ? std::log(width_value) : width_value;
+}
 
-double LogNormalMode::NumberMedianRadiusUm() const {
+double SizeMode::NumberMedianRadiusUm() const {
   const double s2 = LnSigma() * LnSigma();
   if (effective_radius_um) return *effective_radius_um * std::exp(-2.5 * s2);
   SKYBAKE_CHECK(median_radius_um && basis);
   return *basis == SizeBasis::kNumber ? *median_radius_um : *median_radius_um * std::exp(-3.0 * s2);
 }
 
-double LogNormalMode::VolumeMedianRadiusUm() const {
+double SizeMode::VolumeMedianRadiusUm() const {
   return NumberMedianRadiusUm() * std::exp(3.0 * LnSigma() * LnSigma());
 }
-double LogNormalMode::EffectiveRadiusUm() const {
+double SizeMode::EffectiveRadiusUm() const {
   return NumberMedianRadiusUm() * std::exp(2.5 * LnSigma() * LnSigma());
 }
-double LogNormalMode::EffectiveVariance() const { return std::expm1(LnSigma() * LnSigma()); }
-double LogNormalMode::MeanRadiusUm() const { return NumberMedianRadiusUm() * std::exp(0.5 * LnSigma() * LnSigma()); }
+double SizeMode::EffectiveVariance() const { return std::expm1(LnSigma() * LnSigma()); }
+double SizeMode::MeanRadiusUm() const { return NumberMedianRadiusUm() * std::exp(0.5 * LnSigma() * LnSigma()); }
 
-double LogNormalMode::NumberFractionInside() const {
+double SizeMode::NumberFractionInside() const {
+  if (IsTable()) return 1.0;
   const double s = LnSigma();
   const double mu = std::log(NumberMedianRadiusUm());
   return NormalMass((std::log(r_min_um) - mu) / s, (std::log(r_max_um) - mu) / s);
 }
 
-double LogNormalMode::MomentInsideUm(int k) const {
+double SizeMode::MomentInsideUm(int k) const {
+  if (IsTable()) return table->MomentUm(k);
   const double s = LnSigma();
   const double rg = NumberMedianRadiusUm();
   const double mu = std::log(rg);
@@ -100,12 +156,12 @@ double LogNormalMode::MomentInsideUm(int k) const {
   return std::pow(rg, k) * std::exp(0.5 * k * k * s * s) * NormalMass(a - k * s, b - k * s) / NormalMass(a, b);
 }
 
-double LogNormalMode::MeanVolumeInsideUm3() const { return 4.0 / 3.0 * std::numbers::pi * MomentInsideUm(3); }
+double SizeMode::MeanVolumeInsideUm3() const { return 4.0 / 3.0 * std::numbers::pi * MomentInsideUm(3); }
 
 std::vector<double> ParticleType::NumberFractions() const {
   std::vector<double> f;
   double total = 0.0;
-  for (const LogNormalMode& m : modes) {
+  for (const SizeMode& m : modes) {
     const double n = IsVolumeWeight(m.weight_kind) ? m.weight / m.MeanVolumeInsideUm3() : m.weight;
     f.push_back(n);
     total += n;
@@ -141,7 +197,7 @@ ParticleType ParseParticleType(const YamlDocument& doc, const std::string& name)
   for (const YamlNode& node : modes) {
     YamlMap m = node.ToMap("a log-normal mode (a mapping)");
     if (!m.valid()) continue;
-    LogNormalMode mode;
+    SizeMode mode;
     mode.loc = node.loc();
     if (std::optional<YamlNode> n = m.Get("name")) {
       if (std::optional<std::string> s = n->ToString("a lowercase identifier")) {
@@ -163,37 +219,10 @@ ParticleType ParseParticleType(const YamlDocument& doc, const std::string& name)
     } else {
       m.ErrorMissing("refractive_index", "a refractive index (the type gives no default)");
     }
-    // Centre.
-    const std::string centre = m.ExactlyOneOf({"median_radius_um", "effective_radius_um"});
-    if (centre == "median_radius_um") {
-      mode.median_radius_um = m.Number(centre, NumberSpec::Range(1e-4, 100.0, "um"), 1.0);
-      const std::string b = m.Choice("basis", {"number", "volume"});
-      if (!b.empty()) mode.basis = b == "number" ? SizeBasis::kNumber : SizeBasis::kVolume;
-      if (!mode.basis) mode.basis = SizeBasis::kNumber;  // (reported above)
-    } else if (centre == "effective_radius_um") {
-      mode.effective_radius_um = m.Number(centre, NumberSpec::Range(1e-4, 100.0, "um"), 1.0);
-      if (std::optional<YamlNode> b = m.Get("basis")) {
-        b->Error("not used with effective_radius_um (r_eff = <r^3>/<r^2> does not depend on the basis); remove it");
-      }
+    if (std::optional<YamlNode> st = m.Get("size_table")) {
+      ParseSizeTableKey(m, *st, mode);
     } else {
-      m.Known({"basis"});
-    }
-    // Width.
-    const std::string width = m.ExactlyOneOf({"sigma_g", "ln_sigma_g"});
-    if (width == "sigma_g") {
-      mode.width_is_sigma_g = true;
-      mode.width_value = m.Number(width, SigmaG(), 2.0);
-    } else if (width == "ln_sigma_g") {
-      mode.width_value = m.Number(width, LnSigmaG(), 0.5);
-    } else {
-      mode.width_value = 0.5;
-    }
-    // Truncation.
-    mode.r_min_um = m.Number("r_min_um", NumberSpec::Range(1e-4, 100.0, "um"), 0.0);
-    mode.r_max_um = m.Number("r_max_um", NumberSpec::Range(1e-4, 100.0, "um"), 0.0);
-    if (mode.r_min_um > 0.0 && mode.r_max_um > 0.0 && !(mode.r_max_um > mode.r_min_um)) {
-      m.Get("r_max_um")->Error(fmt::format("must be greater than r_min_um ({} <= {})", FormatExact(mode.r_max_um),
-                                           FormatExact(mode.r_min_um)));
+      ParseLogNormalShape(m, mode);
     }
     // Weight.
     if (std::optional<YamlNode> wnode = m.Get("weight")) {
@@ -224,7 +253,8 @@ ParticleType ParseParticleType(const YamlDocument& doc, const std::string& name)
   doc.ThrowIfErrors();
 
   // Cross-field checks that need the numbers.
-  for (const LogNormalMode& mode : type.modes) {
+  for (const SizeMode& mode : type.modes) {
+    if (mode.IsTable()) continue;
     const double z = mode.NumberFractionInside();
     if (!(z >= 1e-12)) {
       doc.diags().Add(mode.loc, fmt::format("mode '{}': [r_min_um, r_max_um] = [{}, {}] holds only {:.3g} of its "
@@ -235,10 +265,27 @@ ParticleType ParseParticleType(const YamlDocument& doc, const std::string& name)
   }
   doc.ThrowIfErrors();
 
-  // Refractive-index tables, each distinct one read once.
+  // Size tables (their bounds become the mode's), then refractive-index tables, each distinct
+  // one read once.
   type.inputs.push_back(doc.display_name());
+  Diagnostics table_errors;
+  for (SizeMode& mode : type.modes) {
+    if (!mode.IsTable()) continue;
+    try {
+      mode.table->Load();
+    } catch (const InputError& e) {
+      for (const Diagnostic& d : e.diagnostics()) table_errors.Add(d.loc, d.message);
+      continue;
+    }
+    mode.r_min_um = mode.table->r_min_um();
+    mode.r_max_um = mode.table->r_max_um();
+    if (std::find(type.inputs.begin(), type.inputs.end(), mode.table->file) == type.inputs.end()) {
+      type.inputs.push_back(mode.table->file);
+    }
+  }
+  table_errors.ThrowIfAny();
   std::map<std::string, RefractiveIndex> loaded;
-  for (LogNormalMode& mode : type.modes) {
+  for (SizeMode& mode : type.modes) {
     if (mode.index.kind != RefractiveIndex::Kind::kTable) continue;
     const std::string key = mode.index.Key();
     auto it = loaded.find(key);
@@ -266,7 +313,7 @@ ParticleType LoadParticleType(const std::filesystem::path& path) {
 
 void CheckWavelengthCoverage(const ParticleType& type, double min_nm, double max_nm) {
   Diagnostics d;
-  for (const LogNormalMode& mode : type.modes) {
+  for (const SizeMode& mode : type.modes) {
     if (!mode.index.Covers(min_nm, max_nm)) {
       d.Add(mode.index.loc,
             fmt::format("mode '{}': the refractive index covers {}, the wavelength grid needs {}-{} nm", mode.name,
@@ -280,7 +327,7 @@ ParticleType SelectMode(const ParticleType& type, const std::string& mode_name) 
   ParticleType out = type;
   out.modes.clear();
   std::vector<std::string> names;
-  for (const LogNormalMode& m : type.modes) {
+  for (const SizeMode& m : type.modes) {
     names.push_back(m.name);
     if (m.name == mode_name) out.modes.push_back(m);
   }
@@ -296,20 +343,24 @@ std::string CanonicalParticleYaml(const ParticleType& type, const std::filesyste
   out << YAML::Comment("canonical particle type " + type.name + " (written by skybake; do not edit)");
   out << YAML::BeginMap;
   out << YAML::Key << "modes" << YAML::Value << YAML::BeginSeq;
-  for (const LogNormalMode& m : type.modes) {
+  for (const SizeMode& m : type.modes) {
     out << YAML::BeginMap;
     out << YAML::Key << "name" << YAML::Value << m.name;
     out << YAML::Key << "refractive_index" << YAML::Value;
     EmitRefractiveIndex(out, m.index, dir);
-    if (m.median_radius_um) {
+    if (m.IsTable()) {
+      out << YAML::Key << "size_table" << YAML::Value << m.table->file.lexically_relative(dir).generic_string();
+    } else if (m.median_radius_um) {
       out << YAML::Key << "basis" << YAML::Value << (*m.basis == SizeBasis::kNumber ? "number" : "volume");
       out << YAML::Key << "median_radius_um" << YAML::Value << FormatExact(*m.median_radius_um);
     } else {
       out << YAML::Key << "effective_radius_um" << YAML::Value << FormatExact(*m.effective_radius_um);
     }
-    out << YAML::Key << (m.width_is_sigma_g ? "sigma_g" : "ln_sigma_g") << YAML::Value << FormatExact(m.width_value);
-    out << YAML::Key << "r_min_um" << YAML::Value << FormatExact(m.r_min_um);
-    out << YAML::Key << "r_max_um" << YAML::Value << FormatExact(m.r_max_um);
+    if (!m.IsTable()) {
+      out << YAML::Key << (m.width_is_sigma_g ? "sigma_g" : "ln_sigma_g") << YAML::Value << FormatExact(m.width_value);
+      out << YAML::Key << "r_min_um" << YAML::Value << FormatExact(m.r_min_um);
+      out << YAML::Key << "r_max_um" << YAML::Value << FormatExact(m.r_max_um);
+    }
     out << YAML::Key << "weight" << YAML::Value << YAML::BeginMap;
     out << YAML::Key << WeightKey(m.weight_kind) << YAML::Value << FormatExact(m.weight);
     out << YAML::EndMap;

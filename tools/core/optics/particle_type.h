@@ -1,6 +1,7 @@
-// Aerosol particle types (particles/*.yaml): an external mixture of log-normal modes of
-// homogeneous spheres, each with a complex refractive index table. Read by mie-tables;
-// referenced by atmospheres through `aerosols[].particle` (docs/mie.md has the full schema).
+// Aerosol particle types (particles/*.yaml): an external mixture of modes of homogeneous
+// spheres, each a log-normal or a tabulated size distribution (optics/size_table.h) with a
+// complex refractive index. Read by mie-tables; referenced by atmospheres through
+// `aerosols[].particle` (docs/mie.md has the full schema).
 //
 //   refractive_index: {table: ../atmospheres/data/water.csv}   # default for every mode
 //   modes:
@@ -13,6 +14,9 @@
 //       r_max_um: 15.0
 //       weight: {relative_volume: 1.0} # number_density_cm3 | relative_number |
 //                                      # volume_um3_per_cm3 | relative_volume (same key in every mode)
+//     - name: measured
+//       size_table: data/site.csv      # instead of basis .. r_max_um: the table's radii bound it
+//       weight: {relative_volume: 1.0}
 //
 // The log-normal family (Hansen & Travis 1974, Space Sci. Rev. 16,
 // 527, eqs. 2.53-2.56): with s = ln sigma_g and r_g the number median radius,
@@ -23,6 +27,8 @@
 // Truncated to [r_min, r_max] with a = (ln r_min - ln r_g)/s, b = (ln r_max - ln r_g)/s:
 //   fraction of the particles inside Z = Phi(b) - Phi(a),
 //   <r^k>_inside = r_g^k e^{k^2 s^2/2} [Phi(b - k s) - Phi(a - k s)] / Z.
+// A tabulated mode's moments are the table's (size_table.h); its bounds are its first and last
+// radius and it holds all of its particles.
 // Weights count the particles (or their volume) inside [r_min, r_max]; a mode's number fraction
 // in the mixture is w_i / sum w_j for number weights, and (w_i/<v>_i) / sum (w_j/<v>_j) for volume
 // weights, <v> the mean particle volume inside the bounds.
@@ -35,19 +41,21 @@
 
 #include "io/error.h"
 #include "optics/refractive_index.h"
+#include "optics/size_table.h"
 
 namespace skybake::mie {
-
-enum class SizeBasis { kNumber, kVolume };
 
 enum class WeightKind { kNumberDensityCm3, kRelativeNumber, kVolumeUm3PerCm3, kRelativeVolume };
 // The YAML key of a weight kind, e.g. "relative_volume".
 const char* WeightKey(WeightKind kind);
 bool IsVolumeWeight(WeightKind kind);
 
-struct LogNormalMode {
+// One mode of the mixture: a log-normal (the fields below) or a table (`table`; then the
+// log-normal fields are unset and r_min_um, r_max_um are the table's first and last radius).
+struct SizeMode {
   std::string name;
   FileLoc loc;  // the mode's mapping
+  std::optional<SizeTable> table;
 
   // Centre: a median (with its basis) or an effective radius, as written (um).
   std::optional<SizeBasis> basis;
@@ -61,7 +69,8 @@ struct LogNormalMode {
   double weight = 0.0;
   RefractiveIndex index;
 
-  // s = ln sigma_g.
+  bool IsTable() const { return table.has_value(); }
+  // s = ln sigma_g (log-normal modes only, as the next five).
   double LnSigma() const;
   // Log-normal algebra (see the header comment), radii in um, untruncated unless named "Inside".
   double NumberMedianRadiusUm() const;
@@ -69,7 +78,7 @@ struct LogNormalMode {
   double EffectiveRadiusUm() const;
   double EffectiveVariance() const;
   double MeanRadiusUm() const;
-  // Fraction of the log-normal's particles inside [r_min, r_max].
+  // Fraction of the log-normal's particles inside [r_min, r_max] (1 for a table).
   double NumberFractionInside() const;
   // <r^k> of the particles inside the bounds, um^k.
   double MomentInsideUm(int k) const;
@@ -80,8 +89,8 @@ struct LogNormalMode {
 struct ParticleType {
   std::string name;            // the file stem
   std::filesystem::path file;  // the YAML it was read from
-  std::vector<LogNormalMode> modes;
-  std::vector<std::filesystem::path> inputs;  // the YAML and every refractive-index table read
+  std::vector<SizeMode> modes;
+  std::vector<std::filesystem::path> inputs;  // the YAML and every refractive-index and size table read
 
   // Number fraction of each mode in the mixture (sums to 1).
   std::vector<double> NumberFractions() const;

@@ -62,7 +62,13 @@ double UpperTrim(double a, double b, double c, double s, double eps) {
 }
 double LowerTrim(double a, double b, double c, double s, double eps) { return -UpperTrim(-b, -a, -c, s, eps); }
 
-Domain QuadratureDomain(const LogNormalMode& mode, double k, const QuadratureOptions& o) {
+// ln(1 um / 1 m): u = ln(r / m) = ln(r / um) + kLnMicron.
+const double kLnMicron = std::log(1e-6);
+
+Domain QuadratureDomain(const SizeMode& mode, double k, const QuadratureOptions& o) {
+  // A table: its whole support (the density is zero outside, and nothing inside is negligible
+  // by construction).
+  if (mode.IsTable()) return {mode.table->ln_r_um.front() + kLnMicron, mode.table->ln_r_um.back() + kLnMicron};
   const double s = mode.LnSigma();
   const double mu = std::log(mode.NumberMedianRadiusUm() * 1e-6);
   const double a = std::log(mode.r_min_um * 1e-6), b = std::log(mode.r_max_um * 1e-6);
@@ -83,11 +89,16 @@ class Group {
   Group(std::complex<double> m, double k, const QuadratureOptions& o) : m_(m), k_(k), o_(o) {}
 
   void AddPart(const MixturePart& p) {
-    const LogNormalMode& mode = *p.mode;
+    const SizeMode& mode = *p.mode;
     Part part;
-    part.s = mode.LnSigma();
-    part.mu = std::log(mode.NumberMedianRadiusUm() * 1e-6);
-    part.scale = p.fraction / (std::sqrt(2.0 * kPi) * part.s * mode.NumberFractionInside());
+    if (mode.IsTable()) {
+      part.table = &*mode.table;
+      part.scale = p.fraction / mode.table->NumberMoment(0);
+    } else {
+      part.s = mode.LnSigma();
+      part.mu = std::log(mode.NumberMedianRadiusUm() * 1e-6);
+      part.scale = p.fraction / (std::sqrt(2.0 * kPi) * part.s * mode.NumberFractionInside());
+    }
     const Domain d = QuadratureDomain(mode, k_, o_);
     SKYBAKE_CHECK_LT(d.u_lo, d.u_hi);
     part.lo = d.u_lo;
@@ -96,11 +107,15 @@ class Group {
     names_ += (names_.empty() ? "" : "+") + mode.name;
   }
 
-  // Panels: the union of every part's partition into pieces of width <= s/2; panels outside
-  // every part's domain are dropped.
+  // Panels: the union of every part's partition into pieces of width <= s/2 (a table: its
+  // intervals, where the density's slope changes); panels outside every part's domain are dropped.
   void Plan() {
     std::vector<double> b;
     for (const Part& p : parts_) {
+      if (p.table) {
+        for (double u : p.table->ln_r_um) b.push_back(u + kLnMicron);
+        continue;
+      }
       const int K = std::max(1, static_cast<int>(std::ceil((p.hi - p.lo) / (o_.u_step_start_sigmas * p.s))));
       for (int i = 0; i <= K; ++i) b.push_back(i == K ? p.hi : p.lo + (p.hi - p.lo) * i / K);
     }
@@ -162,7 +177,8 @@ class Group {
 
  private:
   struct Part {
-    double s, mu, scale, lo, hi;
+    double s = 0.0, mu = 0.0, scale = 0.0, lo = 0.0, hi = 0.0;
+    const SizeTable* table = nullptr;  // a tabulated mode (then s, mu are unused)
   };
   struct Panel {
     double a, b, x_span;
@@ -175,6 +191,10 @@ class Group {
     double d = 0.0;
     for (size_t j : p.active) {
       const Part& part = parts_[j];
+      if (part.table) {
+        d += part.scale * part.table->NumberDensity(u - kLnMicron);
+        continue;
+      }
       const double z = (u - part.mu) / part.s;
       d += part.scale * std::exp(-0.5 * z * z);
     }
@@ -192,7 +212,7 @@ class Group {
 
 }  // namespace
 
-double ModeMaxSizeParameter(const LogNormalMode& mode, double wavelength_nm, const QuadratureOptions& options) {
+double ModeMaxSizeParameter(const SizeMode& mode, double wavelength_nm, const QuadratureOptions& options) {
   const double k = 2.0 * kPi / (wavelength_nm * 1e-9);
   return k * std::exp(QuadratureDomain(mode, k, options).u_hi);
 }
@@ -307,7 +327,7 @@ MixtureIntegral IntegrateMixture(std::span<const MixturePart> parts, double wave
   return result;
 }
 
-MixtureIntegral IntegrateMode(const LogNormalMode& mode, double wavelength_nm, std::complex<double> m,
+MixtureIntegral IntegrateMode(const SizeMode& mode, double wavelength_nm, std::complex<double> m,
                               const PhaseTables* phase, const QuadratureOptions& options) {
   const MixturePart part{&mode, 1.0, m};
   return IntegrateMixture(std::span<const MixturePart>(&part, 1), wavelength_nm, phase, options);
@@ -317,7 +337,21 @@ std::string DescribeModes(const ParticleType& type) {
   const std::vector<double> f = type.NumberFractions();
   std::string out;
   for (size_t i = 0; i < type.modes.size(); ++i) {
-    const LogNormalMode& m = type.modes[i];
+    const SizeMode& m = type.modes[i];
+    if (m.IsTable()) {
+      // Moments of the table itself: r_eff = <r^3>/<r^2>, v_eff = <r^4><r^2>/<r^3>^2 - 1
+      // (Hansen & Travis 1974, eqs. 2.53-2.54).
+      const SizeTable& t = *m.table;
+      const double m2 = t.MomentUm(2), m3 = t.MomentUm(3), m4 = t.MomentUm(4);
+      out += fmt::format(
+          "- mode: {}\n  number_fraction: {:.9g}\n  size_table: \"{}\"\n  size_table_basis: {}\n  size_table_rows: {}\n"
+          "  effective_radius_um: {:.9g}\n  effective_variance: {:.9g}\n  mean_radius_um: {:.9g}\n"
+          "  r_min_um: {:.9g}\n  r_max_um: {:.9g}\n  mean_volume_inside_um3: {:.9g}\n  refractive_index: \"{}\"\n",
+          m.name, f[i], t.file.filename().string(), t.basis == SizeBasis::kVolume ? "volume" : "number",
+          t.ln_r_um.size(), m3 / m2, m4 * m2 / (m3 * m3) - 1.0, t.MomentUm(1), m.r_min_um, m.r_max_um,
+          m.MeanVolumeInsideUm3(), m.index.Describe());
+      continue;
+    }
     out += fmt::format(
         "- mode: {}\n  number_fraction: {:.9g}\n  number_median_radius_um: {:.9g}\n  volume_median_radius_um: {:.9g}\n"
         "  effective_radius_um: {:.9g}\n  effective_variance: {:.9g}\n  mean_radius_um: {:.9g}\n  ln_sigma_g: {:.9g}\n"
@@ -341,7 +375,7 @@ MieBuild BuildMieTable(const ParticleType& type, std::span<const double> wavelen
   const PhaseGrid& grid = options.grid;
   const size_t nw = wavelengths.size(), na = grid.size(), nm = type.modes.size();
   int max_terms = 2;
-  for (const LogNormalMode& mode : type.modes) {
+  for (const SizeMode& mode : type.modes) {
     max_terms = std::max(max_terms, WiscombeTerms(ModeMaxSizeParameter(mode, wl_min, options.quadrature)));
   }
   const PhaseTables tables = MakePhaseTables(grid, max_terms);

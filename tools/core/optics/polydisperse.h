@@ -1,5 +1,5 @@
 // Polydisperse Mie optics: integrals of single-sphere cross sections and scattering intensities
-// over the log-normal modes of a particle type, per wavelength, and the Mie table built from them.
+// over the modes (log-normal or tabulated) of a particle type, per wavelength, and the Mie table built from them.
 //
 // Per mode (number distribution n(u) du over u = ln r, normalised to one particle inside
 // [r_min, r_max]; particle_type.h), with k = 2 pi / lambda and x = k r:
@@ -19,6 +19,9 @@
 //     as long as x < 5 (beyond, Q is bounded and the r^2 bound rules); absorption (~ r^3) lies
 //     between. Each is a log-normal with the same s, centred at ln r_g + p s^2 (Hatch-Choate),
 //     so the cut-offs follow from erfc. The normalisation uses the full [r_min, r_max] (erf);
+//   - a tabulated mode's domain is its table's [r_1, r_n], its pieces the table's intervals (the
+//     density is linear in ln r on each, size_table.h), so the trapezoid meets no kink inside
+//     a panel;
 //   - panels: the union of every mode's partition of its domain into pieces of width <= s/2;
 //     each panel lies wholly inside or outside each mode's domain, so a truncated mode is the
 //     exact composite trapezoid on its own domain. Panel p gets n_p = max(1, ceil(Delta x_p / 2))
@@ -69,7 +72,7 @@ PhaseTables MakePhaseTables(const PhaseGrid& grid, int max_terms, size_t check_s
 // One component of a mixture: a mode, its number fraction in the mixture and its index at the
 // wavelength.
 struct MixturePart {
-  const LogNormalMode* mode = nullptr;
+  const SizeMode* mode = nullptr;
   double fraction = 1.0;
   std::complex<double> m;
 };
@@ -92,11 +95,11 @@ struct MixtureIntegral {
 MixtureIntegral IntegrateMixture(std::span<const MixturePart> parts, double wavelength_nm, const PhaseTables* phase,
                                  const QuadratureOptions& options);
 // One mode alone (fraction 1).
-MixtureIntegral IntegrateMode(const LogNormalMode& mode, double wavelength_nm, std::complex<double> m,
+MixtureIntegral IntegrateMode(const SizeMode& mode, double wavelength_nm, std::complex<double> m,
                               const PhaseTables* phase, const QuadratureOptions& options);
 
 // Largest size parameter a mode's quadrature reaches at a wavelength (for table sizing).
-double ModeMaxSizeParameter(const LogNormalMode& mode, double wavelength_nm, const QuadratureOptions& options);
+double ModeMaxSizeParameter(const SizeMode& mode, double wavelength_nm, const QuadratureOptions& options);
 
 struct MieBuildOptions {
   QuadratureOptions quadrature;

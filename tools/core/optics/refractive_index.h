@@ -1,6 +1,6 @@
 // The complex refractive index m(lambda) = n + i k of a particle material, relative to the
 // surrounding air (n_air - 1 < 3e-4 in the visible, below the accuracy of any aerosol index
-// table; docs/mie.md "Particle types"), from a CSV table or a constant.
+// table; docs/mie.md "Particle types"), from a CSV table, a few points or a constant.
 //
 // Tables (atmospheres/data/*.csv, first line "# source: ..."): a wavelength column with a unit
 // suffix (wavelength_um, wavelength_nm), an n column and a k column (k >= 0: absorbing media
@@ -13,6 +13,16 @@
 //      by orders of magnitude between neighbouring OPAC wavelengths (water: 1e-9 at 450 nm,
 //      1e-7 at 750 nm); an interval with k = 0 at one end is linear (io/interp.h).
 // A wavelength outside the table is an input error (no extrapolation).
+//
+// Points (a retrieval's few wavelengths, e.g. AERONET's 440, 675, 870, 1020 nm):
+//   points: {wavelength_nm: [440, 675, 870, 1020], n: [...], k: [...]}
+//   extrapolation: nearest | linear      # required: the type says which rule it uses
+// Inside the points: the table rule above (n linear, k log-linear). Outside (docs/mie.md,
+// "Refractive index from a few wavelengths"):
+//   nearest: the end point's value (no spectral slope beyond the measured range);
+//   linear:  the end interval continued by the same rule (n linear, ln k linear in wavelength;
+//            linear in k where an end has k = 0, clamped at 0), accepted only where n and k
+//            stay inside their valid ranges over the grid.
 #pragma once
 
 #include <complex>
@@ -28,7 +38,8 @@
 namespace skybake::mie {
 
 struct RefractiveIndex {
-  enum class Kind { kTable, kConstant };
+  enum class Kind { kTable, kConstant, kPoints };
+  enum class Extrapolation { kNearest, kLinear };
   Kind kind = Kind::kConstant;
 
   // kTable: the file (absolute, normalised), row filters and columns.
@@ -37,9 +48,11 @@ struct RefractiveIndex {
   std::string wavelength_column;  // "" = the column named wavelength_<unit>
   std::string n_column = "n_real";
   std::string k_column = "k_imag";
-  // The table after loading (Load), wavelengths in nm.
+  // The table after loading (Load), or the points (set when parsed), wavelengths in nm.
   Interpolant1D n_table, k_table;
   bool loaded = false;
+  // kPoints: the rule outside the points.
+  Extrapolation extrapolation = Extrapolation::kNearest;
 
   // kConstant.
   double constant_n = 1.0;
@@ -63,7 +76,8 @@ struct RefractiveIndex {
 };
 
 // Parses `refractive_index: {table: FILE, select: {...}, wavelength_column: .., n_column: ..,
-// k_column: ..}` or `{n: 1.33, k: 0}`. Problems go to the node's document.
+// k_column: ..}`, `{points: {...}, extrapolation: ...}` or `{n: 1.33, k: 0}`. Problems go to the
+// node's document.
 RefractiveIndex ParseRefractiveIndex(const YamlNode& node);
 
 // Writes the canonical form (paths relative to `dir`) into an emitter positioned at a value.
