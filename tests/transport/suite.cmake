@@ -15,4 +15,5 @@ skybake_add_test_suite(NAME transport DEPS skybake_transport skybake_lut skybake
     Ambient.ThinCloudAureole
     MethodMsApprox.IsotropicSecondOrderMatchesPathTracer
     Stability.MsApproxWithDenseAerosols
-    Stability.MsApproxLutInTwilight)
+    Stability.MsApproxLutInTwilight
+    PathTracerStop.ErrorBarsCoverTheSpreadUnderAThinCloud)

@@ -9,6 +9,7 @@
 
 #include "atmosphere/ray_sphere.h"
 #include "io/error.h"
+#include "transport/running_moments.h"
 
 namespace skybake {
 
@@ -88,6 +89,13 @@ PathTracer::PathTracer(const AtmosphereModel& model, std::vector<std::array<doub
   for (size_t s = 0; s < shells_.size(); ++s) {
     for (size_t w = 0; w < nw; ++w) shell_majorant_[s * nw + w] = model_.MaxExtinction(shells_[s].level_lo, shells_[s].level_hi, w);
   }
+  double peak = 0.0;  // P_max, sr^-1: every phase model here peaks forward or backward
+  for (const MediumComponent& c : model_.components) {
+    if (!c.phase || *std::max_element(c.scattering.begin(), c.scattering.end()) <= 0.0) continue;
+    for (size_t w = 0; w < nw; ++w) peak = std::max({peak, c.phase->Eval(w, 1.0), c.phase->Eval(w, -1.0)});
+  }
+  const double min_paths = std::ceil(settings_.rare_peak_events * 4.0 * kPi * peak);
+  peak_min_paths_ = min_paths >= static_cast<double>(settings_.max_paths) ? settings_.max_paths : static_cast<uint64_t>(min_paths);
 }
 
 size_t PathTracer::ShellOf(double radius) const {
@@ -582,36 +590,29 @@ void PathTracer::ColorPath(const glm::dvec3& position, const glm::dvec3& directi
 ColorEstimate PathTracer::Estimate(const glm::dvec3& position, const glm::dvec3& direction,
                                    const glm::dvec3& sun_direction, uint64_t stream, bool cosine_hemisphere,
                                    double view_t_end, bool single_scattering) const {
-  // Welford accumulators for X, Y, Z.
-  double mean[3] = {0, 0, 0}, m2[3] = {0, 0, 0};
+  RunningMoments acc[3];  // X, Y, Z
   uint64_t n = 0;
   for (;;) {
     for (uint64_t b = 0; b < settings_.batch_paths; ++b, ++n) {
       double xyz[3];
       SamplePath(position, direction, sun_direction, stream, n, cosine_hemisphere, view_t_end, single_scattering, xyz);
-      const double nn = static_cast<double>(n + 1);
-      for (int c = 0; c < 3; ++c) {
-        const double delta = xyz[c] - mean[c];
-        mean[c] += delta / nn;
-        m2[c] += delta * (xyz[c] - mean[c]);
-      }
+      for (int c = 0; c < 3; ++c) acc[c].Add(xyz[c]);
     }
-    if (n >= settings_.min_paths) {
-      const double var_y = n > 1 ? m2[1] / static_cast<double>(n - 1) : 0.0;
-      const double se_y = std::sqrt(var_y / static_cast<double>(n));
+    if (n >= MinPaths()) {
+      const RunningMoments& y = acc[1];
       // An all-zero start (e.g. a view into the Earth's shadow) is not a converged estimate:
       // keep sampling until the floor or max_paths decides.
-      const bool zero_so_far = mean[1] == 0.0 && m2[1] == 0.0;
-      const double tolerance = std::max(settings_.target_relative_error * std::abs(mean[1]), settings_.absolute_error_floor);
-      if ((!zero_so_far && se_y <= tolerance) || n >= settings_.max_paths) break;
+      const bool zero_so_far = y.mean == 0.0 && y.m2 == 0.0;
+      const double tolerance = std::max(settings_.target_relative_error * std::abs(y.mean), settings_.absolute_error_floor);
+      const bool reliable = settings_.stderr_reliability <= 0.0 || y.StdErrRelativeUncertainty() <= settings_.stderr_reliability;
+      if ((!zero_so_far && y.StdErr() <= tolerance && reliable) || n >= settings_.max_paths) break;
     }
   }
   ColorEstimate e;
   e.paths = n;
   for (int c = 0; c < 3; ++c) {
-    e.xyz[static_cast<size_t>(c)] = mean[c];
-    const double var = n > 1 ? m2[c] / static_cast<double>(n - 1) : 0.0;
-    e.xyz_stderr[static_cast<size_t>(c)] = std::sqrt(var / static_cast<double>(n));
+    e.xyz[static_cast<size_t>(c)] = acc[c].mean;
+    e.xyz_stderr[static_cast<size_t>(c)] = acc[c].StdErr();
   }
   return e;
 }

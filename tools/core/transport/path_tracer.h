@@ -35,6 +35,7 @@
 // threads or scheduling.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <limits>
@@ -58,6 +59,20 @@ struct PathTracerSettings {
   // texel darker than the floor need not be resolved relatively. 1e-5 cd/m^2 is ~100x below the
   // natural night-sky luminance (~1e-3 cd/m^2).
   double absolute_error_floor = 1e-5;
+  // ... and only once the standard error is itself known to this relative uncertainty (the
+  // sample kurtosis gives it: transport/running_moments.h). Under a strongly forward-scattering
+  // cloud the samples are heavy-tailed, the sample variance of a few thousand paths understates
+  // the true one, and a stop on it alone accepts estimates that are low by several of their
+  // claimed errors (docs/sky-render.md "Honest error bars"). 0 = no such condition.
+  double stderr_reliability = 0.1;
+  // ... and not before the paths in which the sharpest phase peak is expected this many times:
+  // a sample variance cannot show a tail it has not sampled. A path's next-event connection
+  // falls inside a peak of height P_max (sr^-1), whose solid angle is about 1 / P_max, about
+  // once in 4 pi P_max scattering events, so the stop waits for rare_peak_events x 4 pi P_max
+  // paths (P_max over the scattering components and wavelengths: 0.12 for air, 11 for the
+  // continental aerosol, ~10^3 - 10^4 for cloud droplets). 3 events: a chance of e^-3 = 5 % that
+  // none is seen. 0 = no such minimum.
+  double rare_peak_events = 3.0;
   uint64_t min_paths = 64;
   uint64_t max_paths = uint64_t{1} << 20;
   uint64_t batch_paths = 64;
@@ -101,6 +116,8 @@ class PathTracer {
 
   const AtmosphereModel& model() const { return model_; }
   const PathTracerSettings& settings() const { return settings_; }
+  // Paths an adaptive estimate takes at least (min_paths, or more for a sharp phase peak).
+  uint64_t MinPaths() const { return std::max(settings_.min_paths, peak_min_paths_); }
   const std::vector<std::array<double, 3>>& xyz_weights() const { return xyz_weights_; }
 
   // Sky radiance (XYZ) at `position` (m, planet-centred) looking along `direction` (unit), with
@@ -176,6 +193,7 @@ class PathTracer {
   PathTracerSettings settings_;
   std::vector<Shell> shells_;
   std::vector<double> shell_majorant_;  // [shell * n_wl + wl]
+  uint64_t peak_min_paths_ = 0;         // rare_peak_events x 4 pi P_max (PathTracerSettings)
 };
 
 // Orthonormal direction helpers.
