@@ -202,6 +202,40 @@ class PipelineTest(PipelineTestCase):
         self.assertEqual(r.returncode, 1)
         self.assertIn("pipeline.yaml:8: unknown key 'launchers.profile-imprt' (did you mean 'profile-import'?)", r.stderr)
 
+    def test_references_can_leave_the_default_bake_for_validate(self):
+        # sky.target: validate - the default bake builds everything but the path-traced
+        # references; `skybake validate` builds them (and what they need), a second time nothing.
+        self.edit("pipeline.yaml", "preview: false}", "preview: false, target: validate}")
+        r = self.bake()
+        self.assertEqual(sorted(edges_run(r.stdout)), ["mie-tables mie/tiny.exr", "profile-import clear/profiles.exr",
+                                                       "profile-import hazed/profiles.exr"])
+        self.assertFalse(os.path.exists(os.path.join(self.out, "clear", "sky.exr")))
+        self.assertIn("no work to do", self.ninja().stdout)
+        r = run([tool("skybake"), "validate", "pipeline.yaml"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+        self.assertEqual(sorted(edges_run(r.stdout)), ["sky-render clear/sky.exr", "sky-render hazed/sky.exr"])
+        self.assertIn("no work to do", self.ninja("validate").stdout)
+        # With the default target the references are in the bake, and `validate` names them too.
+        self.edit("pipeline.yaml", "target: validate", "target: default")
+        self.assertIn("no work to do", self.ninja().stdout.splitlines()[-1])
+        with open(os.path.join(self.out, "build.ninja")) as f:
+            self.assertIn("build validate: phony clear/sky.exr hazed/sky.exr\n", f.read())
+
+    def test_unknown_sky_target_is_an_error(self):
+        self.edit("pipeline.yaml", "preview: false}", "preview: false, target: later}")
+        r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("pipeline.yaml:9: key 'sky.target'", r.stderr)
+
+    def test_bake_relays_the_progress_of_running_tools(self):
+        # Ninja holds a command's output until it ends; `skybake bake` relays the tools' progress
+        # channel instead (io/progress_channel.h). At 10 ms every edge of this bake writes lines.
+        r = run([tool("skybake"), "bake", "pipeline.yaml", "--progress-interval", "0.01"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+        relayed = [l for l in r.stdout.splitlines() if re.match(r"^sky-render clear/sky\.exr: .* \(\d+\.\d s\)$", l)]
+        self.assertTrue(relayed, r.stdout)
+        self.assertEqual([n for n in os.listdir(self.out) if "progress" in n], [])
+
 
 class KillMidWriteTest(TempDirTestCase):
     """A tool killed (SIGKILL) while writing leaves the previous output intact."""

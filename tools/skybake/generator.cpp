@@ -42,7 +42,8 @@ void GenContext::AddRegenInput(const fs::path& absolute) {
 
 void GenContext::Build(const std::string& tool, const NinjaBuild& build) {
   ninja_.Build(build);
-  products_.insert(products_.end(), build.outputs.begin(), build.outputs.end());
+  if (!references_ || references_in_default_) products_.insert(products_.end(), build.outputs.begin(), build.outputs.end());
+  if (references_) reference_products_.insert(reference_products_.end(), build.outputs.begin(), build.outputs.end());
   PlannedEdge e{tool, build.outputs, build.inputs};
   e.inputs.insert(e.inputs.end(), build.implicit_inputs.begin(), build.implicit_inputs.end());
   plan_.push_back(std::move(e));
@@ -130,6 +131,13 @@ GenerateResult Generate(const fs::path& pipeline_yaml, const fs::path& tools_dir
   for (const fs::path& p : inputs) phony.outputs.push_back(ctx.Rel(p));
   phony.rule = "phony";
   w.Build(phony);
+  // `ninja validate` (skybake validate): the path-traced references, whether or not the default
+  // builds them.
+  NinjaBuild validate;
+  validate.outputs = {"validate"};
+  validate.rule = "phony";
+  validate.inputs = ctx.references();
+  w.Build(validate);
   w.Newline();
   if (!ctx.products().empty()) w.Default(ctx.products());
 

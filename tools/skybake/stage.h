@@ -52,8 +52,16 @@ class GenContext {
 
   // Emits a build statement and records it for `skybake graph`.
   void Build(const std::string& tool, const NinjaBuild& build);
-  // Every product target (for `default`).
+  // While set, the edges built are the pipeline's path-traced references: their outputs make up
+  // the `validate` phony target (`skybake validate`), and they are default targets only when
+  // `in_default` (pipeline.yaml `sky.target`, docs/pipeline.md).
+  void SetReferenceEdges(bool references, bool in_default = true) {
+    references_ = references;
+    references_in_default_ = in_default;
+  }
+  // Every default target (for `default`) and every reference target (for `validate`).
   const std::vector<std::string>& products() const { return products_; }
+  const std::vector<std::string>& references() const { return reference_products_; }
   const std::vector<PlannedEdge>& plan() const { return plan_; }
   const std::vector<std::filesystem::path>& components() const { return components_; }
   const std::vector<std::filesystem::path>& regen_inputs() const { return regen_inputs_; }
@@ -63,7 +71,8 @@ class GenContext {
   std::filesystem::path tools_dir_;
   bool dry_run_;
   NinjaWriter ninja_;
-  std::vector<std::string> products_;
+  std::vector<std::string> products_, reference_products_;
+  bool references_ = false, references_in_default_ = true;
   std::vector<PlannedEdge> plan_;
   std::vector<std::filesystem::path> components_;
   std::vector<std::filesystem::path> regen_inputs_;

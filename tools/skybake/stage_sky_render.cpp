@@ -17,6 +17,9 @@
 //     atmospheres: [clear, hazed]  # optional: only these get a reference render (default: all)
 //     shards: 4                    # each render as 4 shard edges (slices x texels) + a merge
 //                                  # that writes the EXR and the preview (docs/cluster.md)
+//     target: validate             # default (the default bake builds the references) or
+//                                  # validate (only `skybake validate` / `ninja validate` does)
+// Every reference is an input of the phony target `validate` either way.
 #include <fmt/format.h>
 
 #include <map>
@@ -53,6 +56,7 @@ class SkyRenderStage : public Stage {
     target_error_ = sky->NumberOr("target_error", NumberSpec::Range(1e-4, 1.0, ""), target_error_);
     preview_ = sky->BoolOr("preview", preview_);
     shards_ = ShardsOr(*sky, shards_);
+    in_default_ = sky->ChoiceOr("target", {"default", "validate"}, "default") == "default";
     // A path render's shard task is a texel of a slice, at least one per mirror pair of texels.
     const std::optional<Size2> grid = ParseSize(size_, 2, 8192);
     const size_t tasks = sun_zenith_deg_.size() * (grid ? static_cast<size_t>(grid->width) * grid->height / 2 : 1);
@@ -84,6 +88,7 @@ class SkyRenderStage : public Stage {
       for (const PipelineAtmosphere& a : ctx.pipeline().atmospheres) known = known || a.name == name;
       if (!known) throw InputError(loc, "sky.atmospheres: '" + name + "' is not an atmosphere of this pipeline");
     }
+    ctx.SetReferenceEdges(true, in_default_);
     std::string zeniths;
     for (double z : sun_zenith_deg_) zeniths += (zeniths.empty() ? "" : ",") + FormatExact(z);
     for (const PipelineAtmosphere& a : ctx.pipeline().atmospheres) {
@@ -109,6 +114,7 @@ class SkyRenderStage : public Stage {
       BuildSharded(ctx, tool(), b, preview_ ? " --preview " + paths::SkyPreview(a.name).generic_string() : "", shards_,
                    "sky_merge");
     }
+    ctx.SetReferenceEdges(false);
   }
 
  private:
@@ -119,6 +125,7 @@ class SkyRenderStage : public Stage {
   double target_error_ = 0.05;
   bool preview_ = true;
   int shards_ = 1;
+  bool in_default_ = true;  // sky.target
   std::optional<std::set<std::string>> only_;  // sky.atmospheres
   std::map<std::string, FileLoc> only_loc_;
 };

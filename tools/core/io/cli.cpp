@@ -7,22 +7,41 @@
 
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <mutex>
+#include <thread>
 
 #include "io/error.h"
 #include "io/fileio.h"
+#include "io/progress_channel.h"
+#include "io/progress_log.h"
 #include "skybake/version.h"
 
 namespace skybake {
 
 struct ToolCli::ProgressState {
-  std::mutex mutex;
-  std::chrono::steady_clock::time_point last{};
-  std::string last_stage;
+  std::mutex mutex;  // Info lines
   std::shared_ptr<spdlog::logger> logger;
+  std::unique_ptr<ProgressChannelWriter> channel;
+  std::unique_ptr<ProgressLog> log;
+  // The ticker thread calling log->Tick.
+  std::mutex tick_mutex;
+  std::condition_variable tick_wake;
+  bool tick_stop = false;
+  std::thread ticker;
+
+  void StopTicker() {
+    if (!ticker.joinable()) return;
+    {
+      std::lock_guard<std::mutex> lock(tick_mutex);
+      tick_stop = true;
+    }
+    tick_wake.notify_all();
+    ticker.join();
+  }
 };
 
 ToolCli::ToolCli(std::string name, std::string summary)
@@ -32,12 +51,16 @@ ToolCli::ToolCli(std::string name, std::string summary)
       ->check(CLI::NonNegativeNumber)
       ->default_val(0);
   app_.add_flag("--quiet", quiet_, "Do not print progress lines");
+  app_.add_option("--progress-interval", progress_interval_s_,
+                  "Seconds between progress lines, 0.01 to 3600 (a line at least this often while a stage runs)")
+      ->check(CLI::Range(0.01, 3600.0))
+      ->default_val(1.0);
   app_.failure_message([this](const CLI::App*, const CLI::Error& e) {
     return name_ + ": " + e.what() + "\n" + name_ + ": run '" + name_ + " --help' for usage\n";
   });
 }
 
-ToolCli::~ToolCli() = default;
+ToolCli::~ToolCli() { progress_->StopTicker(); }
 
 void ToolCli::Info(const std::string& message) {
   if (quiet_) return;
@@ -47,17 +70,8 @@ void ToolCli::Info(const std::string& message) {
 
 ProgressFn ToolCli::Progress() {
   std::shared_ptr<ProgressState> state = progress_;
-  std::string name = name_;
-  bool quiet = quiet_;
-  return [state, name, quiet](std::string_view stage, double fraction) {
-    if (quiet) return;
-    std::lock_guard<std::mutex> lock(state->mutex);
-    auto now = std::chrono::steady_clock::now();
-    bool new_stage = stage != state->last_stage;
-    if (!new_stage && fraction < 1.0 && now - state->last < std::chrono::seconds(1)) return;
-    state->last = now;
-    state->last_stage = std::string(stage);
-    state->logger->info("{}: {} {:.0f}%", name, stage, 100.0 * std::clamp(fraction, 0.0, 1.0));
+  return [state](std::string_view stage, double fraction) {
+    if (state->log) state->log->Report(stage, fraction, ProgressLog::Clock::now());
   };
 }
 
@@ -80,7 +94,64 @@ void CheckFiniteOptions(CLI::App* app) {
   for (CLI::App* sub : app->get_subcommands()) CheckFiniteOptions(sub);
 }
 
+// The output a command writes (its -o/--output), for the channel's label; empty if none.
+std::string OutputOption(CLI::App* app) {
+  for (const char* name : {"--output", "-o"}) {
+    const CLI::Option* opt = app->get_option_no_throw(name);
+    if (opt && opt->count() > 0) return opt->results().front();
+  }
+  for (CLI::App* sub : app->get_subcommands()) {
+    std::string out = OutputOption(sub);
+    if (!out.empty()) return out;
+  }
+  return {};
+}
+
+// $SKYBAKE_PROGRESS_INTERVAL: seconds, 0.01 to 3600 (default 5).
+double ChannelInterval() {
+  const char* text = std::getenv(kProgressIntervalEnv);
+  if (!text || !*text) return 5.0;
+  char* end = nullptr;
+  const double v = std::strtod(text, &end);
+  if (end == text || *end != '\0' || !std::isfinite(v) || v < 0.01 || v > 3600.0) {
+    throw UsageError(std::string(kProgressIntervalEnv) + "=" + text + ": expected seconds from 0.01 to 3600");
+  }
+  return v;
+}
+
 }  // namespace
+
+void ToolCli::StartProgress() {
+  ProgressState& st = *progress_;
+  const double channel_interval = ChannelInterval();
+  st.channel = std::make_unique<ProgressChannelWriter>();
+  ProgressLog::Options o;
+  o.tool = name_;
+  const std::string output = OutputOption(&app_);
+  o.label = output.empty() ? name_ : name_ + " " + output;
+  o.stderr_interval_s = progress_interval_s_;
+  o.channel_interval_s = channel_interval;
+  ProgressLog::Sink err, chan;
+  if (!quiet_) {
+    std::shared_ptr<spdlog::logger> logger = st.logger;
+    err = [logger](const std::string& line) { logger->info("{}", line); };
+  }
+  if (st.channel->open()) chan = [&st](const std::string& line) { st.channel->Write(line); };
+  st.log = std::make_unique<ProgressLog>(o, err, chan, ProgressLog::Clock::now());
+  const double period = st.log->TickPeriodSeconds();
+  if (period <= 0.0) return;
+  st.ticker = std::thread([&st, period] {
+    ProgressChannelWriter::BlockSigpipeInThisThread();  // the channel's writes happen here only
+    std::unique_lock<std::mutex> lock(st.tick_mutex);
+    while (!st.tick_stop) {
+      st.tick_wake.wait_for(lock, std::chrono::duration<double>(period));
+      if (st.tick_stop) break;
+      lock.unlock();
+      st.log->Tick(ProgressLog::Clock::now());
+      lock.lock();
+    }
+  });
+}
 
 int ToolCli::Run(int argc, char** argv, const std::function<void()>& body) {
   // Plain stderr sink: no colours (ninja and CI logs), the tool name as prefix.
@@ -113,11 +184,17 @@ int ToolCli::Run(int argc, char** argv, const std::function<void()>& body) {
   } transaction;
   try {
     CheckFiniteOptions(&app_);
+    StartProgress();
+    struct TickerGuard {
+      ProgressState& state;
+      ~TickerGuard() { state.StopTicker(); }  // before any error line is printed
+    } ticker{*progress_};
     if (arena) {
       arena->execute(body);
     } else {
       body();
     }
+    progress_->StopTicker();
     CommitOutputTransaction();
     transaction.done = true;
     return 0;

@@ -60,88 +60,152 @@ __attribute__((always_inline)) inline V8 Splat8(double x) { return V8{x, x, x, x
 
 // G += sum over the batch of w (x x^T + y y^T) for (x, y) = (Re, Im) of alpha (into ga) and of
 // beta (into gb), lower triangle, rows < terms. buf holds, per batch slot r, the arrays
-// [ar, ai, br, bi] of `stride` values (zero beyond the radius' terms) and w_i = the weighted
-// values at each row. Rows are processed in blocks of 8 columns held in registers across the
-// batch (the columns past the diagonal, up to the block's end, are padding: never read back).
+// [ar, ai, br, bi] of `stride` values (zero beyond the radius' terms) and wbuf the same times the
+// radius' weight. The lower triangle is cut into tiles of 4 rows x 16 columns (column blocks
+// from 0, rows from the block's first column on); a tile of both matrices stays in registers
+// while every radius of the batch is added, so G is loaded and stored once per batch, and each
+// radius costs two column loads and one broadcast per row of the tile and matrix. Per element
+// the sum is G + (w_re x_re + w_im x_im), radius after radius in the order given - the order of
+// a plain per-radius loop, so the batch size changes no bit. The columns of a tile past the
+// diagonal, and the rows of a last tile past `terms` (zero in both buffers), are padding: never
+// read back. stride is a multiple of 16 (whole tiles fit in a row and in the rows allocated).
 __attribute__((target_clones("avx512f", "avx2", "default")))
 void GramUpdate(double* ga, double* gb, size_t stride, size_t terms, const double* buf, const double* wbuf,
                 size_t count) {
-  constexpr size_t kMax = 8;
-  for (size_t row = 0; row < terms; ++row) {
-    double* ra = ga + row * stride;
-    double* rb = gb + row * stride;
-    V8 war[kMax], wai[kMax], wbr[kMax], wbi[kMax];
-    for (size_t r = 0; r < count; ++r) {
-      const double* w = wbuf + r * 4 * stride;
-      war[r] = Splat8(w[row]);
-      wai[r] = Splat8(w[stride + row]);
-      wbr[r] = Splat8(w[2 * stride + row]);
-      wbi[r] = Splat8(w[3 * stride + row]);
-    }
-    for (size_t c = 0; c <= row; c += 8) {
-      V8 va = Load8(ra + c), vb = Load8(rb + c);
+  // (Four rows written out: GCC keeps named vectors in registers, arrays of them on the stack.
+  // A scalar times a vector broadcasts the scalar, as Splat8 does.)
+  const size_t slot = 4 * stride;
+  for (size_t c = 0; c < terms; c += 16) {
+    for (size_t row = c; row < terms; row += 4) {
+      double* ra = ga + row * stride + c;
+      double* rb = gb + row * stride + c;
+#define SKYBAKE_TILE_LOAD(i)                                                       \
+  V8 a##i##0 = Load8(ra + (i) * stride), a##i##1 = Load8(ra + (i) * stride + 8); \
+  V8 b##i##0 = Load8(rb + (i) * stride), b##i##1 = Load8(rb + (i) * stride + 8);
+      SKYBAKE_TILE_LOAD(0)
+      SKYBAKE_TILE_LOAD(1)
+      SKYBAKE_TILE_LOAD(2)
+      SKYBAKE_TILE_LOAD(3)
+#undef SKYBAKE_TILE_LOAD
       for (size_t r = 0; r < count; ++r) {
-        const double* b = buf + r * 4 * stride + c;
-        va += war[r] * Load8(b) + wai[r] * Load8(b + stride);
-        vb += wbr[r] * Load8(b + 2 * stride) + wbi[r] * Load8(b + 3 * stride);
+        const double* x = buf + r * slot + c;
+        const double* w = wbuf + r * slot + row;
+        const V8 ar0 = Load8(x), ar1 = Load8(x + 8);
+        const V8 ai0 = Load8(x + stride), ai1 = Load8(x + stride + 8);
+        const V8 br0 = Load8(x + 2 * stride), br1 = Load8(x + 2 * stride + 8);
+        const V8 bi0 = Load8(x + 3 * stride), bi1 = Load8(x + 3 * stride + 8);
+#define SKYBAKE_TILE_ROW(i)                                                \
+  {                                                                        \
+    const double war = w[i], wai = w[stride + (i)];                        \
+    a##i##0 += war * ar0 + wai * ai0;                                      \
+    a##i##1 += war * ar1 + wai * ai1;                                      \
+    const double wbr = w[2 * stride + (i)], wbi = w[3 * stride + (i)];     \
+    b##i##0 += wbr * br0 + wbi * bi0;                                      \
+    b##i##1 += wbr * br1 + wbi * bi1;                                      \
+  }
+        SKYBAKE_TILE_ROW(0)
+        SKYBAKE_TILE_ROW(1)
+        SKYBAKE_TILE_ROW(2)
+        SKYBAKE_TILE_ROW(3)
+#undef SKYBAKE_TILE_ROW
       }
-      __builtin_memcpy(ra + c, &va, sizeof(va));
-      __builtin_memcpy(rb + c, &vb, sizeof(vb));
+#define SKYBAKE_TILE_STORE(i)                                    \
+  __builtin_memcpy(ra + (i) * stride, &a##i##0, sizeof(V8));     \
+  __builtin_memcpy(ra + (i) * stride + 8, &a##i##1, sizeof(V8)); \
+  __builtin_memcpy(rb + (i) * stride, &b##i##0, sizeof(V8));     \
+  __builtin_memcpy(rb + (i) * stride + 8, &b##i##1, sizeof(V8));
+      SKYBAKE_TILE_STORE(0)
+      SKYBAKE_TILE_STORE(1)
+      SKYBAKE_TILE_STORE(2)
+      SKYBAKE_TILE_STORE(3)
+#undef SKYBAKE_TILE_STORE
     }
   }
 }
 
 // out[j] = (p^T G_A p + q^T G_B q)/4 at +mu_j and (q~^T G_A q~ + p~^T G_B p~)/4 at -mu_j, using
 // x^T G x = sum_n x_n (G_nn x_n + 2 sum_{n' < n} G_nn' x_n'); the inner sums run in four
-// interleaved partial sums (n' mod 4) to hide the addition latency.
+// interleaved partial sums (n' mod 4) to hide the addition latency. NT tiles of angles share
+// each pass over G (one broadcast of G_nn' serves NT tiles), so G is read once per NT tiles;
+// every lane's operations are those of a one-tile pass.
+template <size_t NT>
+__attribute__((always_inline)) inline void EvaluateTiles(const double* ga, const double* gb, size_t stride,
+                                                         size_t terms, const double* tiles0, size_t tile_stride,
+                                                         V8* plus, V8* minus) {
+  constexpr size_t T = AngularTables::kTile;
+  constexpr size_t R = AngularTables::kRow;
+  for (size_t t = 0; t < NT; ++t) plus[t] = minus[t] = Splat8(0.0);
+  for (int which = 0; which < 2; ++which) {
+    const double* g = which == 0 ? ga : gb;
+    const size_t part = which == 0 ? 0 : 2 * T;  // (p, q~) with G_A; (q, p~) with G_B
+    V8 acc_x[NT], acc_y[NT];
+    for (size_t t = 0; t < NT; ++t) acc_x[t] = acc_y[t] = Splat8(0.0);
+    for (size_t row = 0; row < terms; ++row) {
+      const double* gr = g + row * stride;
+      V8 sx0[NT], sx1[NT], sx2[NT], sx3[NT], sy0[NT], sy1[NT], sy2[NT], sy3[NT];
+      for (size_t t = 0; t < NT; ++t) {
+        sx0[t] = sx1[t] = sx2[t] = sx3[t] = sy0[t] = sy1[t] = sy2[t] = sy3[t] = Splat8(0.0);
+      }
+      size_t c = 0;
+      for (; c + 4 <= row; c += 4) {
+        const V8 g0 = Splat8(gr[c]), g1 = Splat8(gr[c + 1]), g2 = Splat8(gr[c + 2]), g3 = Splat8(gr[c + 3]);
+        for (size_t t = 0; t < NT; ++t) {
+          const double* tt = tiles0 + t * tile_stride + part + c * R;
+          sx0[t] += g0 * Load8(tt);
+          sy0[t] += g0 * Load8(tt + T);
+          sx1[t] += g1 * Load8(tt + R);
+          sy1[t] += g1 * Load8(tt + R + T);
+          sx2[t] += g2 * Load8(tt + 2 * R);
+          sy2[t] += g2 * Load8(tt + 2 * R + T);
+          sx3[t] += g3 * Load8(tt + 3 * R);
+          sy3[t] += g3 * Load8(tt + 3 * R + T);
+        }
+      }
+      for (; c < row; ++c) {
+        const V8 gv = Splat8(gr[c]);
+        for (size_t t = 0; t < NT; ++t) {
+          const double* tt = tiles0 + t * tile_stride + part + c * R;
+          sx0[t] += gv * Load8(tt);
+          sy0[t] += gv * Load8(tt + T);
+        }
+      }
+      const V8 gd = Splat8(gr[row]);
+      for (size_t t = 0; t < NT; ++t) {
+        const double* tt = tiles0 + t * tile_stride + part + row * R;
+        const V8 sx = (sx0[t] + sx1[t]) + (sx2[t] + sx3[t]), sy = (sy0[t] + sy1[t]) + (sy2[t] + sy3[t]);
+        const V8 x = Load8(tt), y = Load8(tt + T);
+        acc_x[t] += x * (gd * x + 2.0 * sx);
+        acc_y[t] += y * (gd * y + 2.0 * sy);
+      }
+    }
+    for (size_t t = 0; t < NT; ++t) {
+      plus[t] += acc_x[t];
+      minus[t] += acc_y[t];
+    }
+  }
+}
+
 __attribute__((target_clones("avx512f", "avx2", "default")))
 void GramEvaluate(const double* ga, const double* gb, size_t stride, size_t terms, const double* tables,
                   size_t tiles, size_t tile_stride, size_t half, double* out) {
   constexpr size_t T = AngularTables::kTile;
-  constexpr size_t R = AngularTables::kRow;
+  constexpr size_t kPair = 2;
   const size_t n_out = 2 * half - 1;
-  for (size_t k = 0; k < tiles; ++k) {
-    const double* tile = tables + k * tile_stride;
-    V8 plus = Splat8(0.0), minus = Splat8(0.0);
-    for (int which = 0; which < 2; ++which) {
-      const double* g = which == 0 ? ga : gb;
-      const double* tx = tile + (which == 0 ? 0 : 2 * T);  // (p, q~) with G_A; (q, p~) with G_B
-      V8 acc_x = Splat8(0.0), acc_y = Splat8(0.0);
-      for (size_t row = 0; row < terms; ++row) {
-        const double* gr = g + row * stride;
-        V8 sx0 = Splat8(0.0), sx1 = sx0, sx2 = sx0, sx3 = sx0, sy0 = sx0, sy1 = sx0, sy2 = sx0, sy3 = sx0;
-        size_t c = 0;
-        for (; c + 4 <= row; c += 4) {
-          const double* t = tx + c * R;
-          const V8 g0 = Splat8(gr[c]), g1 = Splat8(gr[c + 1]), g2 = Splat8(gr[c + 2]), g3 = Splat8(gr[c + 3]);
-          sx0 += g0 * Load8(t);
-          sy0 += g0 * Load8(t + T);
-          sx1 += g1 * Load8(t + R);
-          sy1 += g1 * Load8(t + R + T);
-          sx2 += g2 * Load8(t + 2 * R);
-          sy2 += g2 * Load8(t + 2 * R + T);
-          sx3 += g3 * Load8(t + 3 * R);
-          sy3 += g3 * Load8(t + 3 * R + T);
-        }
-        for (; c < row; ++c) {
-          const V8 gv = Splat8(gr[c]);
-          sx0 += gv * Load8(tx + c * R);
-          sy0 += gv * Load8(tx + c * R + T);
-        }
-        const V8 sx = (sx0 + sx1) + (sx2 + sx3), sy = (sy0 + sy1) + (sy2 + sy3);
-        const V8 gd = Splat8(gr[row]);
-        const V8 x = Load8(tx + row * R), y = Load8(tx + row * R + T);
-        acc_x += x * (gd * x + 2.0 * sx);
-        acc_y += y * (gd * y + 2.0 * sy);
-      }
-      plus += acc_x;
-      minus += acc_y;
+  for (size_t k = 0; k < tiles; k += kPair) {
+    V8 plus[kPair], minus[kPair];
+    const size_t nt = std::min(kPair, tiles - k);
+    if (nt == kPair) {
+      EvaluateTiles<kPair>(ga, gb, stride, terms, tables + k * tile_stride, tile_stride, plus, minus);
+    } else {
+      EvaluateTiles<1>(ga, gb, stride, terms, tables + k * tile_stride, tile_stride, plus, minus);
     }
-    for (size_t l = 0; l < T; ++l) {
-      const size_t j = k * T + l;
-      if (j >= half) break;
-      out[j] = 0.25 * plus[l];
-      if (j + 1 < half) out[n_out - 1 - j] = 0.25 * minus[l];
+    for (size_t t = 0; t < nt; ++t) {
+      for (size_t l = 0; l < T; ++l) {
+        const size_t j = (k + t) * T + l;
+        if (j >= half) break;
+        out[j] = 0.25 * plus[t][l];
+        if (j + 1 < half) out[n_out - 1 - j] = 0.25 * minus[t][l];
+      }
     }
   }
 }
@@ -151,7 +215,7 @@ void GramEvaluate(const double* ga, const double* gb, size_t stride, size_t term
 
 IntensityAccumulator::IntensityAccumulator(int max_terms)
     : n_(max_terms),
-      stride_((static_cast<size_t>(max_terms) + 7) / 8 * 8),
+      stride_((static_cast<size_t>(max_terms) + 15) / 16 * 16),
       ga_(stride_ * stride_, 0.0),
       gb_(stride_ * stride_, 0.0),
       buf_(kBatch * 4 * stride_, 0.0),
@@ -166,9 +230,14 @@ void IntensityAccumulator::Add(const MieCoefficients& c, double weight) {
   double* b = buf_.data() + count_ * 4 * stride_;
   double* w = wbuf_.data() + count_ * 4 * stride_;
   const size_t n = static_cast<size_t>(c.terms);
-  // The slot may hold a longer earlier radius: zero what this one does not overwrite.
+  // The slot may hold a longer earlier radius: zero what this one does not overwrite, in both
+  // buffers (a row of G past this radius' terms must get w x = 0, and its stale w times this
+  // radius' x would not be).
   if (slot_len_[count_] > n) {
-    for (size_t k = 0; k < 4; ++k) std::fill(b + k * stride_ + n, b + k * stride_ + slot_len_[count_], 0.0);
+    for (size_t k = 0; k < 4; ++k) {
+      std::fill(b + k * stride_ + n, b + k * stride_ + slot_len_[count_], 0.0);
+      std::fill(w + k * stride_ + n, w + k * stride_ + slot_len_[count_], 0.0);
+    }
   }
   slot_len_[count_] = std::max(slot_len_[count_], n);
   for (size_t j = 0; j < n; ++j) {

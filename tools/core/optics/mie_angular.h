@@ -83,12 +83,12 @@ class IntensityAccumulator {
   void Flush();
 
   int n_;
-  size_t stride_;                // n_ rounded up to a multiple of 8 (row length of G and buffers)
+  size_t stride_;                // n_ rounded up to a multiple of 16 (row length of G and buffers)
   std::vector<double> ga_, gb_;  // row-major, lower triangle used
   // Buffered radii (added in batches of kBatch, in order): per slot the real and imaginary parts
   // of alpha and beta (buf_) and the same times the weight (wbuf_), 4 arrays of stride_ values,
   // zero beyond the radius' terms.
-  static constexpr size_t kBatch = 8;
+  static constexpr size_t kBatch = 32;
   size_t count_ = 0;
   int batch_terms_ = 0;
   int used_ = 0;  // largest N added (rows beyond it are zero)
