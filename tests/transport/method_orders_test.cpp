@@ -140,19 +140,22 @@ TEST(MethodOrders, AgainstThePathTracerFromDaylightToTwilight) {
     for (const OrdersCase& c : cases) {
       const std::vector<ColorEstimate> ref = PathY(sc, c.sza, SkyDirs(), c.target);
       const std::vector<double> y = MethodY(sc, *orders, c.sza, SkyDirs());
+      // worst: the largest difference beyond 2 of the reference's own standard errors (a
+      // reference that meets a rare bright path reports the error it has: sun 90 deg, towards
+      // the sun, it reaches max_paths at +-12 %; docs/sky-render.md "Honest error bars").
       double ss = 0.0, noise = 0.0, worst = 0.0;
       for (size_t d = 0; d < y.size(); ++d) {
         const double e = y[d] / ref[d].xyz[1] - 1.0, s = ref[d].xyz_stderr[1] / ref[d].xyz[1];
         ss += e * e;
         noise += s * s;
-        worst = std::max(worst, std::abs(e));
+        worst = std::max(worst, std::abs(e) - 2.0 * s);
         EXPECT_TRUE(std::isfinite(y[d]) && y[d] > 0.0) << atm << " sun " << c.sza << " dir " << d;
       }
       const double rms = std::sqrt(ss / static_cast<double>(y.size()));
       const double rms_corrected = std::sqrt(std::max(0.0, ss - noise) / static_cast<double>(y.size()));
       std::printf("orders vs path, %s sun %.0f deg: RMS %.2f %% (noise-corrected %.2f %%), max %.2f %%\n", atm, c.sza,
                   100.0 * rms, 100.0 * rms_corrected, 100.0 * worst);
-      EXPECT_LT(rms, c.max_rms) << atm << " sun " << c.sza;
+      EXPECT_LT(rms_corrected, c.max_rms) << atm << " sun " << c.sza;
       EXPECT_LT(worst, c.max_abs) << atm << " sun " << c.sza;
     }
   }
