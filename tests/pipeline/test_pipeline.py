@@ -176,9 +176,7 @@ class PipelineTest(PipelineTestCase):
             text = f.read()
         with open(p, "w") as f:
             f.write(re.sub(r"^ground:\n(?:[ #].*\n)*", "", text, flags=re.M))
-        r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)
-        self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
-        self.assertIn("skybake: %s: missing section 'ground'" % p, r.stderr)
+        self.assert_generate_fails("skybake: %s: missing section 'ground'" % p)
         self.assertFalse(os.path.exists(os.path.join(self.out, "build.ninja")))
 
     def test_graph_prints_the_plan_without_writing(self):
@@ -196,11 +194,15 @@ class PipelineTest(PipelineTestCase):
         self.assertRegex(text, r"command = env SKYBAKE_LAUNCHED=1 \S*profile-import ")
         self.assertIn("pool render\n  depth = 1\n", text)
 
+    def assert_generate_fails(self, message):
+        """`skybake generate` exits 1 with `message` on stderr."""
+        r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
+        self.assertIn(message, r.stderr)
+
     def test_unknown_launcher_tool_is_an_error(self):
         self.edit("pipeline.yaml", "pools:", "launchers:\n  profile-imprt: srun\npools:")
-        r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)
-        self.assertEqual(r.returncode, 1)
-        self.assertIn("pipeline.yaml:8: unknown key 'launchers.profile-imprt' (did you mean 'profile-import'?)", r.stderr)
+        self.assert_generate_fails("pipeline.yaml:8: unknown key 'launchers.profile-imprt' (did you mean 'profile-import'?)")
 
     def test_references_can_leave_the_default_bake_for_validate(self):
         # sky.target: validate - the default bake builds everything but the path-traced
@@ -223,9 +225,7 @@ class PipelineTest(PipelineTestCase):
 
     def test_unknown_sky_target_is_an_error(self):
         self.edit("pipeline.yaml", "preview: false}", "preview: false, target: later}")
-        r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)
-        self.assertEqual(r.returncode, 1)
-        self.assertIn("pipeline.yaml:9: key 'sky.target'", r.stderr)
+        self.assert_generate_fails("pipeline.yaml:9: key 'sky.target'")
 
     def test_bake_relays_the_progress_of_running_tools(self):
         # Ninja holds a command's output until it ends; `skybake bake` relays the tools' progress
