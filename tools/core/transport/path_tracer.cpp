@@ -12,7 +12,6 @@
 #include "transport/running_moments.h"
 
 namespace skybake {
-
 namespace {
 
 constexpr double kPi = std::numbers::pi;
@@ -44,6 +43,42 @@ SphereHit NearSphere(const glm::dvec3& p, const glm::dvec3& d, double radius) {
 
 double FarSphere(const glm::dvec3& p, const glm::dvec3& d, double radius) {
   return DistanceToSphereOutDot(glm::dot(p, d), glm::dot(p, p), radius);
+}
+
+// Largest majorant scale of segment NEE's transmittances (TransmittanceAlong): relative
+// variance e^(tau / c) - 1 stays below e - 1 up to tau = 8.
+constexpr double kMaxMajorantScale = 8.0;
+
+// The twilight guide's band (PathTracerSettings::twilight_guide): sin(elevation) in
+// [kBandSinLo, kBandSinHi] above the local horizontal, azimuth within kBandAzimuth of the
+// sun's; uniform in solid angle.
+constexpr double kBandSinLo = -0.1, kBandSinHi = 0.35, kBandAzimuth = kPi / 3.0;
+constexpr double kBandSolidAngle = (kBandSinHi - kBandSinLo) * 2.0 * kBandAzimuth;
+
+// The band's frame at x: up n, towards the sun's azimuth g, and b = n x g; false where the sun
+// is (nearly) straight above or below, so that no azimuth is the sun's.
+bool BandFrame(const glm::dvec3& x, const glm::dvec3& sun, glm::dvec3* n, glm::dvec3* g, glm::dvec3* b) {
+  *n = glm::normalize(x);
+  const glm::dvec3 h = sun - glm::dot(sun, *n) * *n;
+  const double len = glm::length(h);
+  if (len < 1e-6) return false;
+  *g = h / len;
+  *b = glm::cross(*n, *g);
+  return true;
+}
+
+double BandPdf(const glm::dvec3& d, const glm::dvec3& n, const glm::dvec3& g, const glm::dvec3& b) {
+  const double se = glm::dot(d, n);
+  if (se < kBandSinLo || se > kBandSinHi) return 0.0;
+  const double a = std::atan2(glm::dot(d, b), glm::dot(d, g));
+  return std::abs(a) <= kBandAzimuth ? 1.0 / kBandSolidAngle : 0.0;
+}
+
+glm::dvec3 SampleBand(const glm::dvec3& n, const glm::dvec3& g, const glm::dvec3& b, double u1, double u2) {
+  const double se = kBandSinLo + u1 * (kBandSinHi - kBandSinLo);
+  const double ce = std::sqrt(std::max(0.0, 1.0 - se * se));
+  const double a = (2.0 * u2 - 1.0) * kBandAzimuth;
+  return glm::normalize(ce * (std::cos(a) * g + std::sin(a) * b) + se * n);
 }
 
 glm::dvec3 CosineHemisphere(const glm::dvec3& n, double u1, double u2) {
@@ -94,8 +129,15 @@ PathTracer::PathTracer(const AtmosphereModel& model, std::vector<std::array<doub
     if (!c.phase || *std::max_element(c.scattering.begin(), c.scattering.end()) <= 0.0) continue;
     for (size_t w = 0; w < nw; ++w) peak = std::max({peak, c.phase->Eval(w, 1.0), c.phase->Eval(w, -1.0)});
   }
+  shadow_radius_m_ = model_.bottom_radius_m -
+                     (model_.sun.angular_radius_rad * DistanceToHorizon(model_.top_radius_m, model_.bottom_radius_m) + 1.0);
   const double min_paths = std::ceil(settings_.rare_peak_events * 4.0 * kPi * peak);
   peak_min_paths_ = min_paths >= static_cast<double>(settings_.max_paths) ? settings_.max_paths : static_cast<uint64_t>(min_paths);
+}
+
+bool PathTracer::InEarthShadow(const glm::dvec3& x, const glm::dvec3& sun) const {
+  const double xs = glm::dot(x, sun);
+  return xs < 0.0 && glm::dot(x, x) - xs * xs < shadow_radius_m_ * shadow_radius_m_;
 }
 
 size_t PathTracer::ShellOf(double radius) const {
@@ -130,7 +172,8 @@ void PathTracer::Transmittance(const glm::dvec3& position, const glm::dvec3& dir
 }
 
 void PathTracer::TransmittanceAlong(const glm::dvec3& position, const glm::dvec3& direction, double t_max,
-                                    const size_t* idx, int k, Pcg32& rng, double* T) const {
+                                    const size_t* idx, int k, Pcg32& rng, double* T, double roulette_below,
+                                    double majorant_scale) const {
   for (int j = 0; j < k; ++j) T[j] = 1.0;
   double travelled = 0.0;
   glm::dvec3 p = position;
@@ -144,7 +187,7 @@ void PathTracer::TransmittanceAlong(const glm::dvec3& position, const glm::dvec3
     double t_exit = down ? inner.t : FarSphere(p, direction, sh.radius_hi);
     const bool last = travelled + t_exit >= t_max;
     if (last) t_exit = t_max - travelled;
-    const double mu_bar = Majorant(s, idx, k);
+    const double mu_bar = majorant_scale * Majorant(s, idx, k);
     double t = 0.0;
     if (mu_bar > 0.0) {
       for (;;) {
@@ -158,8 +201,8 @@ void PathTracer::TransmittanceAlong(const glm::dvec3& position, const glm::dvec3
           tmax = std::max(tmax, T[j]);
         }
         // Russian roulette on tiny transmittances (unbiased: survivors are reweighted).
-        if (tmax < 1e-3) {
-          const double q = tmax / 1e-3;
+        if (tmax < roulette_below) {
+          const double q = tmax / roulette_below;
           if (rng.Uniform() >= q) {
             for (int j = 0; j < k; ++j) T[j] = 0.0;
             return;
@@ -222,18 +265,10 @@ void PathTracer::SegmentSunNee(const glm::dvec3& p, const glm::dvec3& d, const d
   const SphereHit g = NearSphere(p, d, R);
   const double t_end = std::min(t_cap, g.hit ? g.t : FarSphere(p, d, top));
   if (!(t_end > 0.0)) return;
-  // Lit set along x(t) = p + t d: the planet hides the whole disk from x iff x.s < 0 and the
-  // distance of x from the shadow axis is below the planet radius, shrunk by the penumbra
-  // (angular radius x the longest sunlit chord through the atmosphere) so that points lit by
-  // part of the disk are kept (the estimator stays unbiased; NEE then finds the exact visibility).
-  const double margin = model_.sun.angular_radius_rad * DistanceToHorizon(top, R) + 1.0;
-  const double rs = R - margin;
+  // Lit set along x(t) = p + t d: the points outside the umbra (InEarthShadow).
+  const double rs = shadow_radius_m_;
   const double ps = glm::dot(p, sun), ds = glm::dot(d, sun);
-  auto lit = [&](double t) {
-    const glm::dvec3 x = p + t * d;
-    const double xs = glm::dot(x, sun);
-    return xs >= 0.0 || glm::dot(x, x) - xs * xs >= rs * rs;
-  };
+  auto lit = [&](double t) { return !InEarthShadow(p + t * d, sun); };
   double bp[6];
   int nb = 0;
   bp[nb++] = 0.0;
@@ -275,16 +310,43 @@ void PathTracer::SegmentSunNee(const glm::dvec3& p, const glm::dvec3& d, const d
     }
   }
   if (nl == 0) return;
-  // Pieces over the lit part, weights ~ a technique wavelength's scattering x attenuation
-  // (midpoint rule), a piecewise-constant sampling density that is exactly known. One technique
-  // (the hero idx[0]), or with wavelength_mis one per carried wavelength, the piece drawn from a
-  // uniformly chosen one and its density the techniques' mixture (one-sample MIS).
+  // Pieces over the lit part. A technique wavelength's weight W(t) = scattering x attenuation
+  // along the segment (trapezoid rule) x (sun_guided_nee) the tabulated attenuation towards the
+  // sun of the least attenuated carried wavelength is evaluated at the pieces' ends and taken log-linear within each piece (uniform where
+  // an end has none): a density that is exactly known and follows the exponential fall of W
+  // along a grazing ray, where a constant per piece leaves rare points with large weights. One
+  // technique (the hero idx[0]), or with wavelength_mis one per carried wavelength, the piece
+  // drawn from a uniformly chosen one and the density the techniques' mixture (one-sample MIS).
   constexpr int kPieces = 64;
   const int nh = settings_.wavelength_mis ? k : 1;
+  const SunDepthTable* sun_depth = settings_.sun_guided_nee ? &SunDepth() : nullptr;
   double piece_lo[kPieces + 5], piece_len[kPieces + 5];
-  double piece_w[kMaxWavelengths][kPieces + 5];
+  double piece_w0[kMaxWavelengths][kPieces + 5], piece_w1[kMaxWavelengths][kPieces + 5];
+  double piece_mass[kMaxWavelengths][kPieces + 5];
+  double piece_tau[kMaxWavelengths][kPieces + 5];  // view optical depth at the piece's start
   double total[kMaxWavelengths], tau[kMaxWavelengths];
   for (int h = 0; h < nh; ++h) total[h] = tau[h] = 0.0;
+  // W at t (and the extinction there, for the trapezoid rule) for every technique.
+  double w_at[kMaxWavelengths], ext_at[kMaxWavelengths];
+  auto weights_at = [&](double t) {
+    const glm::dvec3 x = p + t * d;
+    const double rx = glm::length(x);
+    const AtmosphereModel::Cell cell = model_.Locate(rx - R);
+    const double mu_sun = glm::dot(x, sun) / rx;
+    // The sun factor: the least attenuated carried wavelength's, so that no carried wavelength
+    // is sampled below its own light (a 680 nm sun ray through the lower atmosphere keeps light
+    // that a 420 nm one has lost: with the hero's factor its points would be rare and heavy).
+    double sun_factor = 1.0;
+    if (sun_depth) {
+      double tau_min = SunDepthTable::kMaxDepth;
+      for (int j = 0; j < k; ++j) tau_min = std::min(tau_min, sun_depth->Depth(rx, mu_sun, idx[j]));
+      sun_factor = std::exp(-tau_min);
+    }
+    for (int hh = 0; hh < nh; ++hh) {
+      ext_at[hh] = model_.Extinction(cell, idx[hh]);
+      w_at[hh] = model_.Scattering(cell, idx[hh]) * std::exp(-tau[hh]) * sun_factor;
+    }
+  };
   int np = 0;
   double t_prev = 0.0;
   for (int i = 0; i < nl; ++i) {
@@ -299,16 +361,34 @@ void PathTracer::SegmentSunNee(const glm::dvec3& p, const glm::dvec3& d, const d
     }
     const int n = std::max(1, static_cast<int>(std::round(kPieces * (lit_hi[i] - lit_lo[i]) / lit_len)));
     const double h = (lit_hi[i] - lit_lo[i]) / n;
+    weights_at(lit_lo[i]);
     for (int q = 0; q < n && np < kPieces + 5; ++q) {
-      const double tm = lit_lo[i] + (q + 0.5) * h;
-      const glm::dvec3 x = p + tm * d;
-      const AtmosphereModel::Cell cell = model_.Locate(glm::length(x) - R);
+      double w0[kMaxWavelengths], e0[kMaxWavelengths];
       for (int hh = 0; hh < nh; ++hh) {
-        const double ext = model_.Extinction(cell, idx[hh]);
-        const double w = model_.Scattering(cell, idx[hh]) * std::exp(-(tau[hh] + 0.5 * ext * h)) * h;
-        tau[hh] += ext * h;
-        piece_w[hh][np] = w;
-        total[hh] += w;
+        w0[hh] = w_at[hh];
+        e0[hh] = ext_at[hh];
+        piece_tau[hh][np] = tau[hh];
+      }
+      // The end's W needs the depth there, which needs the end's extinction: the trapezoid
+      // step takes the end's extinction from a first evaluation at the start's depth.
+      const double t1 = lit_lo[i] + (q + 1) * h;
+      weights_at(t1);
+      for (int hh = 0; hh < nh; ++hh) {
+        const double dtau = 0.5 * (e0[hh] + ext_at[hh]) * h;
+        tau[hh] += dtau;
+        w_at[hh] *= std::exp(-dtau);
+        piece_w0[hh][np] = w0[hh];
+        piece_w1[hh][np] = w_at[hh];
+        const double a = w0[hh], b = w_at[hh];
+        double mass;
+        if (a > 0.0 && b > 0.0) {
+          const double beta = std::log(b / a);
+          mass = std::abs(beta) > 1e-9 ? h * (b - a) / beta : h * a;
+        } else {
+          mass = 0.5 * (a + b) * h;
+        }
+        piece_mass[hh][np] = mass;
+        total[hh] += mass;
       }
       piece_lo[np] = lit_lo[i] + q * h;
       piece_len[np] = h;
@@ -328,17 +408,35 @@ void PathTracer::SegmentSunNee(const glm::dvec3& p, const glm::dvec3& d, const d
   double u = rng.Uniform() * total[tech];
   int chosen = np - 1;
   for (int i = 0; i < np; ++i) {
-    if (u < piece_w[tech][i]) {
+    if (u < piece_mass[tech][i]) {
       chosen = i;
       break;
     }
-    u -= piece_w[tech][i];
+    u -= piece_mass[tech][i];
   }
-  if (piece_w[tech][chosen] <= 0.0) return;
-  const double t_star = piece_lo[chosen] + rng.Uniform() * piece_len[chosen];
+  if (piece_mass[tech][chosen] <= 0.0) return;
+  // Density within the piece of technique hh at fraction f of it (per metre, normalised over
+  // the segment), and the inverse of the chosen technique's distribution within the piece.
+  auto log_linear = [&](int hh) {
+    const double a = piece_w0[hh][chosen], b = piece_w1[hh][chosen];
+    return a > 0.0 && b > 0.0 ? std::log(b / a) : std::numeric_limits<double>::quiet_NaN();
+  };
+  auto density = [&](int hh, double f) {
+    const double beta = log_linear(hh);
+    if (std::isnan(beta)) return piece_mass[hh][chosen] / (piece_len[chosen] * total[hh]);
+    return piece_w0[hh][chosen] * std::exp(beta * f) / total[hh];
+  };
+  const double u2 = rng.Uniform();
+  double frac = u2;
+  {
+    const double beta = log_linear(tech);
+    if (!std::isnan(beta) && std::abs(beta) > 1e-9) frac = std::clamp(std::log1p(u2 * std::expm1(beta)) / beta, 0.0, 1.0);
+  }
+  const double t_star = piece_lo[chosen] + frac * piece_len[chosen];
   double pdf = 0.0;
-  for (int q = 0; q < nu; ++q) pdf += piece_w[usable[q]][chosen] / (total[usable[q]] * piece_len[chosen]);
+  for (int q = 0; q < nu; ++q) pdf += density(usable[q], frac);
   pdf /= nu;
+  if (!(pdf > 0.0)) return;
   const glm::dvec3 x = p + t_star * d;
   const AtmosphereModel::Cell cell = model_.Locate(glm::length(x) - R);
   // Sun direction in the disk's cone.
@@ -355,11 +453,36 @@ void PathTracer::SegmentSunNee(const glm::dvec3& p, const glm::dvec3& d, const d
     any = any || f[j] != 0.0;
   }
   if (!any) return;
+  // The transmittances follow the optical depths the wavelengths are expected to see (the
+  // pieces' view depth of the techniques, the tabulated sun depth of the carried ones): the
+  // roulette starts 1e-3 below the least attenuated one's expectation (it acts on the largest
+  // T), the majorant scale is the largest depth (kMaxMajorantScale at most).
+  double view_min = INFINITY, view_max = 0.0, sun_min = INFINITY, sun_max = 0.0;
+  for (int q = 0; q < nu; ++q) {
+    view_min = std::min(view_min, piece_tau[usable[q]][chosen]);  // at the piece's start
+    view_max = std::max(view_max, piece_tau[usable[q]][chosen]);
+  }
+  if (sun_depth) {
+    const double rx = glm::length(x), mu_sun = glm::dot(x, sun) / rx;
+    for (int j = 0; j < k; ++j) {
+      const double t = sun_depth->Depth(rx, mu_sun, idx[j]);
+      sun_min = std::min(sun_min, t);
+      sun_max = std::max(sun_max, t);
+    }
+  } else {
+    sun_min = 0.0;
+  }
   double t_view[kMaxWavelengths], t_sun[kMaxWavelengths];
-  TransmittanceAlong(p, d, t_star, idx, k, rng, t_view);
-  Transmittance(x, wl, idx, k, rng, t_sun);
+  TransmittanceAlong(p, d, t_star, idx, k, rng, t_view, 1e-3 * std::exp(-view_min), std::clamp(view_max, 1.0, kMaxMajorantScale));
+  TransmittanceAlong(x, wl, std::numeric_limits<double>::infinity(), idx, k, rng, t_sun, 1e-3 * std::exp(-sun_min),
+                     std::clamp(sun_max, 1.0, kMaxMajorantScale));
   const double omega = sm.SolidAngle();
   for (int j = 0; j < k; ++j) L[j] += f[j] * t_view[j] * t_sun[j] * sm.Radiance(idx[j], alpha) * omega / pdf;
+}
+
+const SunDepthTable& PathTracer::SunDepth() const {
+  std::call_once(sun_depth_once_, [this] { sun_depth_ = std::make_unique<SunDepthTable>(model_); });
+  return *sun_depth_;
 }
 
 namespace {
@@ -524,8 +647,19 @@ void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, co
       // the pdf then the mixture over the k (one-sample MIS).
       const int nh = settings_.wavelength_mis ? k : 1;
       const int tech = nh > 1 ? std::min(nh - 1, static_cast<int>(rng.Uniform() * nh)) : 0;
-      const double mu = model_.components[chosen].phase->SampleMu(idx[tech], rng.Uniform());
-      const glm::dvec3 d_new = RotateAround(d, mu, 2.0 * kPi * rng.Uniform());
+      // In the Earth's shadow (twilight_guide): half of the directions from the sunward band.
+      glm::dvec3 bn, bg, bb;
+      const bool guide = settings_.twilight_guide && sun_mode && segment_nee && InEarthShadow(p, sun) &&
+                         BandFrame(p, sun, &bn, &bg, &bb);
+      glm::dvec3 d_new;
+      double mu;
+      if (guide && rng.Uniform() < 0.5) {
+        d_new = SampleBand(bn, bg, bb, rng.Uniform(), rng.Uniform());
+        mu = std::clamp(glm::dot(d, d_new), -1.0, 1.0);
+      } else {
+        mu = model_.components[chosen].phase->SampleMu(idx[tech], rng.Uniform());
+        d_new = RotateAround(d, mu, 2.0 * kPi * rng.Uniform());
+      }
       // Mixture pdf (solid angle) of the sampled direction.
       double pdf = 0.0;
       for (int h = 0; h < nh; ++h) {
@@ -536,6 +670,7 @@ void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, co
         pdf += ph;
       }
       pdf /= nh;
+      if (guide) pdf = 0.5 * pdf + 0.5 * BandPdf(d_new, bn, bg, bb);
       if (!(pdf > 0.0)) return;
       for (int j = 0; j < k; ++j) beta[j] *= MixturePhase(cell, idx[j], mu) / pdf;
       d = d_new;  // the vertex is inside shell s: the traversal continues from there

@@ -19,10 +19,15 @@
 //  - Scattering: the next direction is sampled from the mixture of the components' phase
 //    functions at the hero wavelength with component probabilities proportional to
 //    sum_j b_j mu_s,c(lambda_j); each wavelength is weighted by its own mixture phase / pdf.
-//  - Sun: next-event estimation at every scattering and ground vertex, with a direction drawn
+//    At a vertex in the Earth's shadow, half of the directions come from a band towards the
+//    sun's azimuth instead (twilight_guide, one-sample MIS).
+//  - Sun: next-event estimation along every path segment (segment_nee: a point of the sunlit
+//    part drawn from a log-linear density that follows scattering x attenuation, towards the
+//    sun too with sun_guided_nee) and at every ground vertex, with a direction drawn
 //    uniformly in the solar disk's cone (limb darkening in the radiance), transmittance by
-//    ratio tracking (Cramer 1978; Novak et al. 2014) with the same shell majorants, zero when the
-//    shadow ray hits the planet (Earth's shadow). Paths that leave the atmosphere collect
+//    ratio tracking (Cramer 1978; Novak et al. 2014) with the shell majorants (scaled up where
+//    a depth of several is expected), zero when the shadow ray hits the planet (Earth's
+//    shadow); or, with segment_nee off, at every scattering vertex. Paths that leave the atmosphere collect
 //    nothing in sun mode (so the sun is never counted twice); the sun disk itself is not part
 //    of the sky radiance (it is the separate direct-sun output).
 //  - Uniform illumination (white-furnace mode): paths that leave the atmosphere collect a
@@ -39,12 +44,15 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <memory>
+#include <mutex>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
 #include "atmosphere/model.h"
 #include "transport/random.h"
+#include "transport/sun_depth_table.h"
 
 namespace skybake {
 
@@ -85,6 +93,22 @@ struct PathTracerSettings {
   // and it keeps twilight (where most of the medium is in the Earth's shadow) tractable.
   // false: sun NEE at every collision only (the textbook estimator; kept to cross-check).
   bool segment_nee = true;
+  // Segment NEE's density also follows the sun's attenuation: each piece's weight is multiplied
+  // by exp(-tau) to the sun from a tabulated optical depth (transport/sun_depth_table.h). In
+  // twilight most of the geometrically sunlit air sees the sun only through the lower
+  // atmosphere's long grazing path; the plain density spends its points there
+  // (docs/sky-render.md "Deep twilight"). false: the density follows scattering x view
+  // attenuation only.
+  bool sun_guided_nee = true;
+  // At a scattering vertex in the Earth's shadow, the next direction is drawn half of the time
+  // from the phase function and half of the time uniformly in a band about the horizontal
+  // direction towards the sun's azimuth (elevation asin(-0.1) to asin(0.35), azimuth within
+  // 60 deg: 0.94 sr), weighted by phase / the mixture's density (one-sample MIS, Veach 1997,
+  // §9.2.4). From the shadowed lower atmosphere of deep twilight that band is where the sunlit
+  // air is seen; the phase function points there rarely (docs/sky-render.md "Deep twilight").
+  // Only shadowed vertices use it: the choice depends on the vertex alone, so the estimator is
+  // unbiased. false: the phase function alone.
+  bool twilight_guide = true;
   // Highest scattering order counted (ground reflections count as orders); 0 = all orders.
   int max_order = 0;
   // Wavelength-sampling decisions (the segment-NEE point, the phase-function direction).
@@ -160,8 +184,16 @@ class PathTracer {
   void Transmittance(const glm::dvec3& position, const glm::dvec3& direction, const size_t* idx, int k, Pcg32& rng,
                      double* T) const;
   // The same up to a distance t_max along the ray (unblocked by the ground before t_max).
+  // Russian roulette ends the tracking once every T[j] is below `roulette_below` (survivors are
+  // reweighted): an estimate of a transmittance expected to be small passes its expected value
+  // times 1e-3, so that the roulette does not turn a small but sought-after transmittance into
+  // a rare large weight.
+  // `majorant_scale` c >= 1 multiplies the shells' majorants: with the majorant at the
+  // extinction, ratio tracking degenerates to a 0/1 estimate of relative variance e^tau - 1;
+  // with c it is e^(tau / c) - 1 (homogeneous medium) at c times the lookups, which a caller
+  // expecting an optical depth of several pays where it matters.
   void TransmittanceAlong(const glm::dvec3& position, const glm::dvec3& direction, double t_max, const size_t* idx,
-                          int k, Pcg32& rng, double* T) const;
+                          int k, Pcg32& rng, double* T, double roulette_below = 1e-3, double majorant_scale = 1.0) const;
 
   static constexpr int kMaxWavelengths = 16;
 
@@ -178,6 +210,11 @@ class PathTracer {
   void SamplePath(const glm::dvec3& position, const glm::dvec3& direction, const glm::dvec3& sun_direction, uint64_t stream,
                   uint64_t n, bool cosine_hemisphere, double view_t_end, bool single_scattering, double* xyz) const;
   size_t ShellOf(double radius) const;
+  // The planet hides the whole sun disk from x: x.s < 0 and x's distance from the shadow axis
+  // is below shadow_radius_m_, the planet radius shrunk by the penumbra (the disk's angular
+  // radius x the longest sunlit chord through the atmosphere, + 1 m), so that points lit by
+  // part of the disk are outside (the estimators stay unbiased; NEE finds the exact visibility).
+  bool InEarthShadow(const glm::dvec3& x, const glm::dvec3& sun) const;
   double Majorant(size_t shell, const size_t* idx, int k) const;
   // Sun next-event estimate at a medium or ground vertex: adds to L.
   void SunNee(const glm::dvec3& x, const glm::dvec3& d, bool ground, const double* beta, const size_t* idx, int k,
@@ -193,7 +230,13 @@ class PathTracer {
   PathTracerSettings settings_;
   std::vector<Shell> shells_;
   std::vector<double> shell_majorant_;  // [shell * n_wl + wl]
+  double shadow_radius_m_ = 0.0;        // InEarthShadow
   uint64_t peak_min_paths_ = 0;         // rare_peak_events x 4 pi P_max (PathTracerSettings)
+  // Built on the first guided segment NEE (sun_guided_nee): a tracer that never needs it
+  // (uniform illumination, fixed-order tests) does not pay for it.
+  const SunDepthTable& SunDepth() const;
+  mutable std::once_flag sun_depth_once_;
+  mutable std::unique_ptr<SunDepthTable> sun_depth_;
 };
 
 // Orthonormal direction helpers.
