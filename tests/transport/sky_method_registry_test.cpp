@@ -165,7 +165,9 @@ TEST(OrdersOverrides, TwilightSplitParts) {
   EXPECT_EQ(orders::TwilightWeight(s, 91.0 * kDeg), 1.0);
   o.table_size["split_day_to_deg"] = 90;
   EXPECT_NE(UsageMessage([&] { orders::SettingsFor(o); }).find("split_day_to_deg: 90"), std::string::npos);
-  o.table_size["split_from_deg"] = 0;
+  o.table_size = {{"split_from_deg", 150}, {"split_day_to_deg", 160}, {"split_twilight_from_deg", 150}};
+  EXPECT_EQ(UsageMessage([&] { orders::SettingsFor(o); }), "orders: fewer than 2 sun nodes in a part of the twilight split");
+  o.table_size = {{"split_from_deg", 0}, {"split_day_to_deg", 90}};
   EXPECT_EQ(orders::SettingsFor(o).split_from_deg, 0.0);
 }
 

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "io/error.h"
+#include "transport/orders/split.h"
 
 namespace skybake::orders {
 
@@ -23,7 +24,8 @@ const QualityTable<OrdersSettings>& OrdersPresets() {
       // 93 deg (22 of the 42: the tables to 92 deg move the sky at sun 90 deg by up to 0.1 %, to 93
       // deg by <= 0.006 %, in Y over 77 directions of the hazed sky on the 20 nm test grid, against
       // one solve of all 42), and medium's view, azimuth, kernel and cones from 85 deg (29 nodes;
-      // from 0 or 80 deg the same within 0.07 %), blended over sun zenith 90-91 deg. The twilight
+      // from 80 deg the same to 0.001 % RMS, from 0 deg <= 0.11 % closer to the one solve at sun
+      // 90-105 deg), blended over sun zenith 90-91 deg. The twilight
       // tables are 1.3 / 1.6 / 2.3 % RMS (max 3.3 / 4.2 / 6.3 %) from one solve at high at sun 92
       // / 95 / 100 deg there.
       OrdersSettings{.nup = 24, .ndn = 12, .nphi = 36, .nss = 96, .fine = 512, .truncation_deg = 3.0,
@@ -133,6 +135,12 @@ OrdersSettings SettingsFor(const SkyMethodOptions& o) {
         "(split_day_to_deg: {}) and its twilight part from at most {} deg (split_twilight_from_deg: {})",
         s.split_from_deg, s.split_from_deg + s.split_width_deg, s.split_from_deg + s.split_width_deg, s.split_day_to_deg,
         s.split_from_deg, s.split_twilight_from_deg));
+  }
+  if (s.split_from_deg > 0.0) {
+    const SplitSettings parts = SplitParts(s);
+    if (parts.day.sun_deg.size() < 2 || parts.twilight.sun_deg.size() < 2) {
+      throw UsageError("orders: fewer than 2 sun nodes in a part of the twilight split");
+    }
   }
   if (s.nr < 3 || s.nup < 2 || s.ndn < 2 || s.nphi < 2 || s.nt < 4 || s.nss < 4) {
     throw UsageError("orders: table sizes are too small");
