@@ -15,6 +15,7 @@
 #include "transport/method_ms_approx.h"
 #include "transport/method_single.h"
 #include "transport/orders/settings.h"
+#include "transport/orders/split.h"
 #include "transport/quality.h"
 #include "transport/sky_method.h"
 
@@ -139,6 +140,37 @@ TEST(OrdersOverrides, EachKindSetsItsSetting) {
   EXPECT_EQ(s.sun_nr, 48);
 }
 
+// The twilight split's parts: the daylight one with high's tables and its sun nodes to 93 deg,
+// the twilight one with medium's view, azimuth, kernel and cones and its sun nodes from 85 deg;
+// a split whose parts do not reach across the blend zone is an error.
+TEST(OrdersOverrides, TwilightSplitParts) {
+  SkyMethodOptions o;
+  o.quality = Quality::kHigh;
+  const orders::OrdersSettings s = orders::SettingsFor(o);
+  EXPECT_EQ(s.sun_deg.size(), 42u);
+  const orders::SplitSettings p = orders::SplitParts(s);
+  EXPECT_EQ(p.day.split_from_deg, 0.0);
+  EXPECT_EQ(p.twilight.split_from_deg, 0.0);
+  EXPECT_EQ(p.day.sun_deg.size(), 22u);
+  EXPECT_EQ(p.day.sun_deg.back(), 93.0);
+  EXPECT_EQ(std::vector<int>({p.day.nup, p.day.ndn, p.day.nphi, p.day.kernel_sub}), std::vector<int>({24, 12, 36, 4}));
+  EXPECT_EQ(p.twilight.sun_deg.size(), 29u);
+  EXPECT_EQ(p.twilight.sun_deg.front(), 85.0);
+  EXPECT_EQ(std::vector<int>({p.twilight.nup, p.twilight.ndn, p.twilight.nphi, p.twilight.kernel_sub, p.twilight.nr, p.twilight.nss}),
+            std::vector<int>({16, 8, 8, 0, 16, 96}));
+  EXPECT_EQ(p.twilight.truncation_deg, 5.0);
+  EXPECT_EQ(p.twilight.truncation_min_deg, 5.0);
+  EXPECT_EQ(orders::TwilightWeight(s, 90.0 * kDeg), 0.0);
+  EXPECT_DOUBLE_EQ(orders::TwilightWeight(s, 90.5 * kDeg), 0.5);
+  EXPECT_EQ(orders::TwilightWeight(s, 91.0 * kDeg), 1.0);
+  o.table_size["split_day_to_deg"] = 90;
+  EXPECT_NE(UsageMessage([&] { orders::SettingsFor(o); }).find("split_day_to_deg: 90"), std::string::npos);
+  o.table_size = {{"split_from_deg", 150}, {"split_day_to_deg", 160}, {"split_twilight_from_deg", 150}};
+  EXPECT_EQ(UsageMessage([&] { orders::SettingsFor(o); }), "orders: fewer than 2 sun nodes in a part of the twilight split");
+  o.table_size = {{"split_from_deg", 0}, {"split_day_to_deg", 90}};
+  EXPECT_EQ(orders::SettingsFor(o).split_from_deg, 0.0);
+}
+
 // The preset tables hold the documented values (docs/sky-methods.md, "Qualities").
 TEST(Presets, OrdersTable) {
   const auto& p = orders::OrdersPresets();
@@ -159,6 +191,11 @@ TEST(Presets, OrdersTable) {
   EXPECT_EQ(hi.tolerance, 3e-4);
   EXPECT_EQ(hi.truncation_deg, 3.0);
   EXPECT_EQ(hi.truncation_min_deg, 1.0);
+  // The twilight split (transport/orders/split.h): high only.
+  EXPECT_EQ(std::vector<double>({hi.split_from_deg, hi.split_width_deg, hi.split_day_to_deg, hi.split_twilight_from_deg}),
+            std::vector<double>({90.0, 1.0, 93.0, 85.0}));
+  EXPECT_EQ(lo.split_from_deg, 0.0);
+  EXPECT_EQ(me.split_from_deg, 0.0);
   for (const orders::OrdersSettings* s : {&lo, &me, &hi}) {
     EXPECT_EQ(s->max_orders, 40);
     EXPECT_EQ(s->sun_low_step_deg, 0.1);

@@ -25,10 +25,12 @@
 //    and dense next to it; sun nodes dense from 80 to 110 deg; radius nodes dense near the
 //    ground; one radius node at the observer. Values are linear in every coordinate except the
 //    output's sun angle, which is interpolated log-linearly (twilight light decays
-//    exponentially with the sun's depression).
+//    exponentially with the sun's depression). `high` solves its daylight sun nodes at its own
+//    resolution and its twilight ones at medium's angular resolution, blending the two across
+//    sun zenith 90-91 deg (the twilight split, orders/split.h).
 // Everything is vectorised over wavelength (float, wavelength innermost).
 // The implementation, one phase per file: transport/orders/ (settings, medium, sun_tables, nodes,
-// rays, kernel, modal_kernel, transport, transport_split, solve, render, simd; method.cpp).
+// rays, kernel, modal_kernel, transport, transport_split, solve, render, simd, split; method.cpp).
 #pragma once
 
 #include <memory>

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "io/error.h"
+#include "transport/orders/split.h"
 
 namespace skybake::orders {
 
@@ -18,9 +19,18 @@ const QualityTable<OrdersSettings>& OrdersPresets() {
       // not. With the 1 deg aerosol cone the multiple-scattering aureole of a low sun needs 36
       // azimuths (hazed, sun 85 deg: 0.45 % RMS, max 1.19 %, against 0.53 / 2.11 % with 24). 96
       // view steps are within 0.005 % RMS of 160, and medium's 1 deg twilight nodes within 0.2 %
-      // RMS of 0.5 deg ones at sun 90-98 deg (the twilight target is 3 %).
+      // RMS of 0.5 deg ones at sun 90-98 deg (the twilight target is 3 %). The twilight split
+      // (split.h; docs/sky-methods.md "The twilight split"): these tables with the sun nodes to
+      // 93 deg (22 of the 42: the tables to 92 deg move the sky at sun 90 deg by up to 0.1 %, to 93
+      // deg by <= 0.006 %, in Y over 77 directions of the hazed sky on the 20 nm test grid, against
+      // one solve of all 42), and medium's view, azimuth, kernel and cones from 85 deg (29 nodes;
+      // from 80 deg the same to 0.001 % RMS, from 0 deg <= 0.11 % closer to the one solve at sun
+      // 90-105 deg), blended over sun zenith 90-91 deg. The twilight
+      // tables are 1.3 / 1.6 / 2.3 % RMS (max 3.3 / 4.2 / 6.3 %) from one solve at high at sun 92
+      // / 95 / 100 deg there.
       OrdersSettings{.nup = 24, .ndn = 12, .nphi = 36, .nss = 96, .fine = 512, .truncation_deg = 3.0,
-                     .truncation_min_deg = 1.0, .sun_nr = 192, .kernel_sub = 4, .tolerance = 3e-4},
+                     .truncation_min_deg = 1.0, .sun_nr = 192, .kernel_sub = 4, .tolerance = 3e-4,
+                     .split_from_deg = 90.0, .split_width_deg = 1.0, .split_day_to_deg = 93.0, .split_twilight_from_deg = 85.0},
   }};
   return presets;
 }
@@ -56,6 +66,10 @@ const std::vector<OrdersOverride>& OrdersOverrides() {
       {"sun_step_deg", K::kCount, 1, 80, 1.0, &S::sun_step_deg},
       {"low_sun_step_x10", K::kScaled, 1, 100, 10.0, &S::low_sun_step_deg},
       {"twilight_step_x10", K::kScaled, 1, 200, 10.0, &S::twilight_step_deg},
+      {"split_from_deg", K::kScaled, 0, 180, 1.0, &S::split_from_deg},
+      {"split_width_x10", K::kScaled, 1, 200, 10.0, &S::split_width_deg},
+      {"split_day_to_deg", K::kScaled, 0, 180, 1.0, &S::split_day_to_deg},
+      {"split_twilight_from_deg", K::kScaled, 0, 180, 1.0, &S::split_twilight_from_deg},
   };
   return overrides;
 }
@@ -80,22 +94,26 @@ void Apply(const OrdersOverride& o, int value, OrdersSettings* s) {
   if (auto* f = std::get_if<double OrdersSettings::*>(&o.field)) s->*(*f) = value / o.divisor;
 }
 
+}  // namespace
+
 // Sun zenith nodes: every sun_step_deg (10) up to 80, then low_sun_step_deg (1 deg) to 90,
 // twilight_step_deg (1 deg) through the low sun and twilight to 110, then 112, 115, 120
 // (beyond: no sunlight reaches the atmosphere's sunlit part that matters; J is taken as 0).
 // From 80 to 90 deg the sources fall steeply and convexly: with the sun on the horizon, 1 deg
 // nodes and the log-linear blend from 85 deg put the clear sky 0.5 deg above the horizon, 40 deg
 // from the sun's azimuth, within 0.1 % of the path tracer (high; 387.1 cd/m2 +- 0.37 %).
+// Only the nodes within [sun_min_deg, sun_max_deg] are kept.
 std::vector<double> SunNodes(const OrdersSettings& s) {
   std::vector<double> deg;
-  for (double a = 0; a < 80; a += s.sun_step_deg) deg.push_back(a);
-  for (double a = 80; a < 90 - 1e-9; a += s.low_sun_step_deg) deg.push_back(a);
-  for (double a = 90; a <= 110 + 1e-9; a += s.twilight_step_deg) deg.push_back(a);
-  for (double a : {112.0, 115.0, 120.0}) deg.push_back(a);
+  auto add = [&](double a) {
+    if (a >= s.sun_min_deg - 1e-9 && a <= s.sun_max_deg + 1e-9) deg.push_back(a);
+  };
+  for (double a = 0; a < 80; a += s.sun_step_deg) add(a);
+  for (double a = 80; a < 90 - 1e-9; a += s.low_sun_step_deg) add(a);
+  for (double a = 90; a <= 110 + 1e-9; a += s.twilight_step_deg) add(a);
+  for (double a : {112.0, 115.0, 120.0}) add(a);
   return deg;
 }
-
-}  // namespace
 
 OrdersSettings SettingsFor(const SkyMethodOptions& o) {
   CheckOverrideKeys("orders", o.table_size, OverrideKeys());
@@ -109,6 +127,21 @@ OrdersSettings SettingsFor(const SkyMethodOptions& o) {
   if (o.orders > 0) s.max_orders = o.orders;
   if (o.order_tolerance > 0) s.tolerance = o.order_tolerance;
   s.sun_deg = SunNodes(s);
+  if (s.sun_deg.size() < 2) throw UsageError("orders: fewer than 2 sun nodes in the sun range");
+  if (s.split_from_deg > 0.0 && (s.split_day_to_deg < s.split_from_deg + s.split_width_deg - 1e-9 ||
+                                 s.split_twilight_from_deg > s.split_from_deg + 1e-9)) {
+    throw UsageError(fmt::format(
+        "orders: the twilight split blends over sun zenith {} to {} deg, so its daylight part needs sun nodes to at least {} deg "
+        "(split_day_to_deg: {}) and its twilight part from at most {} deg (split_twilight_from_deg: {})",
+        s.split_from_deg, s.split_from_deg + s.split_width_deg, s.split_from_deg + s.split_width_deg, s.split_day_to_deg,
+        s.split_from_deg, s.split_twilight_from_deg));
+  }
+  if (s.split_from_deg > 0.0) {
+    const SplitSettings parts = SplitParts(s);
+    if (parts.day.sun_deg.size() < 2 || parts.twilight.sun_deg.size() < 2) {
+      throw UsageError("orders: fewer than 2 sun nodes in a part of the twilight split");
+    }
+  }
   if (s.nr < 3 || s.nup < 2 || s.ndn < 2 || s.nphi < 2 || s.nt < 4 || s.nss < 4) {
     throw UsageError("orders: table sizes are too small");
   }

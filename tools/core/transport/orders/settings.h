@@ -76,8 +76,25 @@ struct OrdersSettings {
   int sun_step_deg = 10;
   double low_sun_step_deg = 1.0;
   double twilight_step_deg = 1.0;
+  // The sun nodes' range: SunNodes cut to [sun_min_deg, sun_max_deg] (a solve of part of the sun
+  // range: the two parts of the twilight split, split.h).
+  double sun_min_deg = 0.0;
+  double sun_max_deg = 180.0;
+  // The twilight split (split.h; docs/sky-methods.md "The twilight split"): 0 = one solve over
+  // every sun node; > 0 = two solves, the daylight one at these settings with its sun nodes up to
+  // split_day_to_deg, the twilight one at medium's angular resolution (view, azimuth, kernel,
+  // cones) with its sun nodes from split_twilight_from_deg, the answers blended from the daylight
+  // to the twilight part over sun zenith split_from_deg to split_from_deg + split_width_deg.
+  double split_from_deg = 0.0;
+  double split_width_deg = 1.0;
+  double split_day_to_deg = 0.0;
+  double split_twilight_from_deg = 0.0;
   std::vector<double> sun_deg = {};  // sun zenith nodes (SettingsFor)
 };
+
+// The sun zenith nodes of s (deg): the spacing of sun_step_deg, low_sun_step_deg and
+// twilight_step_deg, cut to [sun_min_deg, sun_max_deg].
+std::vector<double> SunNodes(const OrdersSettings& s);
 
 // The presets: low, medium (the defaults above) and high.
 const QualityTable<OrdersSettings>& OrdersPresets();
