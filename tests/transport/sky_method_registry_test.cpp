@@ -141,7 +141,8 @@ TEST(OrdersOverrides, EachKindSetsItsSetting) {
 }
 
 // The twilight split's parts: the daylight one with high's tables and its sun nodes to 93 deg,
-// the twilight one with medium's view, azimuth, kernel and cones and its sun nodes from 85 deg;
+// the twilight one with high's view nodes, medium's azimuths, kernel and cones and its sun nodes
+// from 85 deg;
 // a split whose parts do not reach across the blend zone is an error.
 TEST(OrdersOverrides, TwilightSplitParts) {
   SkyMethodOptions o;
@@ -157,7 +158,7 @@ TEST(OrdersOverrides, TwilightSplitParts) {
   EXPECT_EQ(p.twilight.sun_deg.size(), 29u);
   EXPECT_EQ(p.twilight.sun_deg.front(), 85.0);
   EXPECT_EQ(std::vector<int>({p.twilight.nup, p.twilight.ndn, p.twilight.nphi, p.twilight.kernel_sub, p.twilight.nr, p.twilight.nss}),
-            std::vector<int>({16, 8, 8, 0, 16, 96}));
+            std::vector<int>({24, 12, 8, 0, 16, 96}));
   EXPECT_EQ(p.twilight.truncation_deg, 5.0);
   EXPECT_EQ(p.twilight.truncation_min_deg, 5.0);
   EXPECT_EQ(orders::TwilightWeight(s, 90.0 * kDeg), 0.0);

@@ -23,11 +23,12 @@ const QualityTable<OrdersSettings>& OrdersPresets() {
       // (split.h; docs/sky-methods.md "The twilight split"): these tables with the sun nodes to
       // 93 deg (22 of the 42: the tables to 92 deg move the sky at sun 90 deg by up to 0.1 %, to 93
       // deg by <= 0.006 %, in Y over 77 directions of the hazed sky on the 20 nm test grid, against
-      // one solve of all 42), and medium's view, azimuth, kernel and cones from 85 deg (29 nodes;
-      // from 80 deg the same to 0.001 % RMS, from 0 deg <= 0.11 % closer to the one solve at sun
-      // 90-105 deg), blended over sun zenith 90-91 deg. The twilight
-      // tables are 1.3 / 1.6 / 2.3 % RMS (max 3.3 / 4.2 / 6.3 %) from one solve at high at sun 92
-      // / 95 / 100 deg there.
+      // one solve of all 42), and medium's azimuths, kernel and cones with high's view nodes from
+      // 85 deg (29 nodes; from 80 deg the same to 0.001 % RMS, from 0 deg <= 0.11 % closer to the
+      // one solve at sun 90-105 deg), blended over sun zenith 90-91 deg. The twilight tables are
+      // 0.86 / 1.35 / 1.63 % RMS (max 2.5 / 3.2 / 4.1 %) from one solve at high at sun 92 / 95 /
+      // 100 deg there; medium's view nodes would put the ground 1 deg below the horizon at 5x the
+      // one solve's radiance (its first down node is 1.8 deg below the horizon, high's 0.7 deg).
       OrdersSettings{.nup = 24, .ndn = 12, .nphi = 36, .nss = 96, .fine = 512, .truncation_deg = 3.0,
                      .truncation_min_deg = 1.0, .sun_nr = 192, .kernel_sub = 4, .tolerance = 3e-4,
                      .split_from_deg = 90.0, .split_width_deg = 1.0, .split_day_to_deg = 93.0, .split_twilight_from_deg = 85.0},

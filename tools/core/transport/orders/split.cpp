@@ -11,12 +11,13 @@ SplitSettings SplitParts(const OrdersSettings& s) {
   p.day.split_from_deg = 0.0;
   p.day.sun_max_deg = std::min(s.sun_max_deg, s.split_day_to_deg);
   p.day.sun_deg = SunNodes(p.day);
-  // Medium's angular resolution: the view nodes, the azimuths, the kernel and the cones (its
-  // truncation_min_deg 0 reads as its truncation_deg, as in SettingsFor).
+  // Medium's azimuths, kernel and cones (its truncation_min_deg 0 reads as its truncation_deg, as
+  // in SettingsFor); high's view nodes, whose first one below the horizon resolves the ground's
+  // dark band 1-2 deg down (docs/sky-methods.md, "The twilight split").
   const OrdersSettings& med = OrdersPresets()[Quality::kMedium];
   OrdersSettings& t = p.twilight;
   t.split_from_deg = 0.0;
-  t.nup = med.nup, t.ndn = med.ndn, t.nphi = med.nphi, t.view_power = med.view_power;
+  t.nphi = med.nphi;
   t.kernel_sub = med.kernel_sub;
   t.truncation_deg = med.truncation_deg;
   t.truncation_min_deg = med.truncation_min_deg > 0.0 && med.truncation_min_deg <= med.truncation_deg ? med.truncation_min_deg : med.truncation_deg;
