@@ -145,8 +145,8 @@ def main():
                     help="time each render N times and keep the shortest (a shared or virtual machine's "
                          "speed drifts by ~20 %% between minutes)")
     ap.add_argument("--references", default="",
-                    help="folder of the cached path references (default: <work>/references): <sky>.csv, "
-                         "`sky-render points --method path` at the bench's 140 geometries, and <sky>.key")
+                    help="folder of the cached path references (default: <work>/references): <sky>_day.csv and "
+                         "<sky>_twilight.csv (`sky-render points --method path` at the bench's 140 geometries) and <sky>.key")
     ap.add_argument("--make-references", action="store_true",
                     help="path-trace the references that are missing or stale (the atmosphere, profiles or Mie "
                          "tables changed) for the skies benched; slow (docs/benchmarks.md)")
