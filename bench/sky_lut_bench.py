@@ -24,7 +24,7 @@ against a cached path reference at the same geometries - the noise-corrected RMS
 outside the 1 deg aureole in daylight (target 0.5 % / 2 %; the max includes the reference's noise) and the RMS at sun 95 deg
 (target 3 %). The references live in <work>/references (or --references DIR): per sky a daylight
 and a twilight CSV and the hash of what they depend on (the sky's render.yaml, profiles and Mie
-tables); --make-references path-traces the missing or stale ones (at --ref-target-error, default
+tables, the geometries, the wavelength grid and the path tracer's settings); --make-references path-traces the missing or stale ones (at --ref-target-error, default
 0.5 % in daylight and 2 % in twilight; minutes per clear sky, docs/benchmarks.md). A sky without
 a fresh reference prints "no reference". --size WxH renders every sky at that size
 instead of the pipeline's (32x128 for all 8: every sky at the clear sky's size; the pipeline
@@ -66,8 +66,7 @@ def timed(args, cwd):
     err = p.stderr.read().decode(errors="replace")
     _, status, usage = os.wait4(p.pid, 0)
     dt = time.perf_counter() - t0
-    p.returncode = os.waitstatus_to_exitcode(status)
-    if p.returncode != 0:
+    if os.waitstatus_to_exitcode(status) != 0:
         sys.exit("failed: %s\n%s" % (" ".join(args), err))
     return dt, usage.ru_maxrss / 1024.0
 
@@ -107,9 +106,10 @@ def from_sun_deg(sza, vz, az):
     return math.degrees(math.acos(max(-1.0, min(1.0, c))))
 
 
-def sky_key(out, sky):
-    """What a reference depends on: the bytes of the sky's render.yaml, profiles and Mie tables."""
-    h = hashlib.sha256()
+def sky_key(out, sky, how):
+    """What a reference depends on: the bytes of the sky's render.yaml, profiles and Mie tables, and
+    how it is made (`how`: the geometries and the path tracer's settings)."""
+    h = hashlib.sha256(how.encode())
     for rel in sorted(["%s/components/render.yaml" % sky, "%s/profiles.exr" % sky] +
                       [os.path.join("mie", m) for m in os.listdir(os.path.join(out, "mie")) if m.endswith(".exr")]):
         with open(os.path.join(out, rel), "rb") as f:
@@ -185,6 +185,7 @@ def main():
     parts = [("day", DAY_SUNS, a.ref_target_error.split(",")[0]), ("twilight", TWILIGHT_SUNS, a.ref_target_error.split(",")[-1])]
     for name, suns, _ in parts:
         write_geometry(os.path.join(a.work, "geometry_%s.csv" % name), suns)
+    how = repr((parts, VIEWS, a.ref_max_paths, a.wavelengths))
     print("%-8s %-7s %-7s %7s %11s %8s %21s %9s %s" % ("sky", "size", "quality", "build_s", "render_s", "peak_MiB",
                                                     "day RMS / max %", "twi RMS %", "(wall s and peak memory at threads "
                                                     + a.threads + "; errors in Y against the path references)"))
@@ -210,7 +211,7 @@ def main():
         same = len({open(os.path.join(a.work, "%s_t%d.exr" % (sky, t)), "rb").read() for t in threads}) == 1
         points = [os.path.join(os.path.abspath(a.bin), "sky-render"), "--quiet", "points"] + scene + [
             "--wavelengths-out", "550", "--threads", str(max(threads))]
-        key, keyfile = sky_key(out, sky), os.path.join(refdir, sky + ".key")
+        key, keyfile = sky_key(out, sky, how), os.path.join(refdir, sky + ".key")
         refs = {name: os.path.join(refdir, "%s_%s.csv" % (sky, name)) for name, _, _ in parts}
         fresh = all(os.path.exists(r) for r in refs.values()) and os.path.exists(keyfile) and open(keyfile).read().strip() == key
         if not fresh and a.make_references:
