@@ -69,9 +69,10 @@ __attribute__((always_inline)) inline V8 Splat8(double x) { return V8{x, x, x, x
 // a plain per-radius loop, so the batch size changes no bit. The columns of a tile past the
 // diagonal, and the rows of a last tile past `terms` (zero in both buffers), are padding: never
 // read back. stride is a multiple of 16 (whole tiles fit in a row and in the rows allocated).
-__attribute__((target_clones("avx512f", "avx2", "default")))
-void GramUpdate(double* ga, double* gb, size_t stride, size_t terms, const double* buf, const double* wbuf,
-                size_t count) {
+// This tile takes 16 registers of 8 doubles for the two matrices and 8 for the radius' columns:
+// it is the AVX-512 kernel (32 registers). GramUpdate chooses the kernel.
+__attribute__((target("avx512f"))) void GramUpdateAvx512(double* ga, double* gb, size_t stride, size_t terms,
+                                                         const double* buf, const double* wbuf, size_t count) {
   // (Four rows written out: GCC keeps named vectors in registers, arrays of them on the stack.
   // A scalar times a vector broadcasts the scalar, as Splat8 does.)
   const size_t slot = 4 * stride;
@@ -121,6 +122,84 @@ void GramUpdate(double* ga, double* gb, size_t stride, size_t terms, const doubl
 #undef SKYBAKE_TILE_STORE
     }
   }
+}
+
+
+// Four doubles as one value: the AVX2 kernel's lanes (one AVX2 register, two SSE2 registers).
+typedef double V4 __attribute__((vector_size(32)));
+#if defined(__clang__)
+typedef double V4Unaligned __attribute__((vector_size(32), aligned(8)));
+#define Load4(p) (*reinterpret_cast<const V4Unaligned*>(p))
+#else
+__attribute__((always_inline)) inline V4 Load4(const double* p) {
+  V4 v;
+  __builtin_memcpy(&v, p, sizeof(v));
+  return v;
+}
+#endif
+
+// GramUpdateAvx512's sums in tiles of 4 rows x 4 columns: the two matrices' tiles take 8
+// registers of 4 doubles and the radius' columns 4, within AVX2's 16 (the 4 x 16 tile there
+// needs 48 and spends its time spilling them: the water cloud's table took 7-9x longer on an
+// AVX2 machine). Every element gets the same operations in the same order as in the 4 x 16 tile
+// (G + (w_re x_re + w_im x_im), radius after radius; no fused multiply-add): the same bits on any
+// CPU (tests/optics/mie_angular_test.cpp). Columns past the diagonal and rows past `terms` are
+// padding, as there.
+__attribute__((always_inline)) inline void GramUpdateTiles4(double* ga, double* gb, size_t stride, size_t terms,
+                                                            const double* buf, const double* wbuf, size_t count) {
+  const size_t slot = 4 * stride;
+  for (size_t c = 0; c < terms; c += 4) {
+    for (size_t row = c; row < terms; row += 4) {
+      double* ra = ga + row * stride + c;
+      double* rb = gb + row * stride + c;
+#define SKYBAKE_TILE_LOAD(i)         \
+  V4 a##i = Load4(ra + (i) * stride); \
+  V4 b##i = Load4(rb + (i) * stride);
+      SKYBAKE_TILE_LOAD(0)
+      SKYBAKE_TILE_LOAD(1)
+      SKYBAKE_TILE_LOAD(2)
+      SKYBAKE_TILE_LOAD(3)
+#undef SKYBAKE_TILE_LOAD
+      for (size_t r = 0; r < count; ++r) {
+        const double* x = buf + r * slot + c;
+        const double* w = wbuf + r * slot + row;
+        const V4 ar = Load4(x), ai = Load4(x + stride), br = Load4(x + 2 * stride), bi = Load4(x + 3 * stride);
+#define SKYBAKE_TILE_ROW(i)                                            \
+  {                                                                    \
+    a##i += w[i] * ar + w[stride + (i)] * ai;                          \
+    b##i += w[2 * stride + (i)] * br + w[3 * stride + (i)] * bi;       \
+  }
+        SKYBAKE_TILE_ROW(0)
+        SKYBAKE_TILE_ROW(1)
+        SKYBAKE_TILE_ROW(2)
+        SKYBAKE_TILE_ROW(3)
+#undef SKYBAKE_TILE_ROW
+      }
+#define SKYBAKE_TILE_STORE(i)                               \
+  __builtin_memcpy(ra + (i) * stride, &a##i, sizeof(V4)); \
+  __builtin_memcpy(rb + (i) * stride, &b##i, sizeof(V4));
+      SKYBAKE_TILE_STORE(0)
+      SKYBAKE_TILE_STORE(1)
+      SKYBAKE_TILE_STORE(2)
+      SKYBAKE_TILE_STORE(3)
+#undef SKYBAKE_TILE_STORE
+    }
+  }
+}
+__attribute__((target("avx2"))) void GramUpdateAvx2(double* ga, double* gb, size_t stride, size_t terms, const double* buf,
+                                                    const double* wbuf, size_t count) {
+  GramUpdateTiles4(ga, gb, stride, terms, buf, wbuf, count);
+}
+void GramUpdateBaseline(double* ga, double* gb, size_t stride, size_t terms, const double* buf, const double* wbuf,
+                        size_t count) {
+  GramUpdateTiles4(ga, gb, stride, terms, buf, wbuf, count);
+}
+
+void GramUpdate(double* ga, double* gb, size_t stride, size_t terms, const double* buf, const double* wbuf, size_t count) {
+  static const int isa = __builtin_cpu_supports("avx512f") ? 2 : __builtin_cpu_supports("avx2") ? 1 : 0;
+  if (isa == 2) GramUpdateAvx512(ga, gb, stride, terms, buf, wbuf, count);
+  else if (isa == 1) GramUpdateAvx2(ga, gb, stride, terms, buf, wbuf, count);
+  else GramUpdateBaseline(ga, gb, stride, terms, buf, wbuf, count);
 }
 
 // out[j] = (p^T G_A p + q^T G_B q)/4 at +mu_j and (q~^T G_A q~ + p~^T G_B p~)/4 at -mu_j, using
@@ -185,9 +264,11 @@ __attribute__((always_inline)) inline void EvaluateTiles(const double* ga, const
   }
 }
 
-__attribute__((target_clones("avx512f", "avx2", "default")))
-void GramEvaluate(const double* ga, const double* gb, size_t stride, size_t terms, const double* tables,
-                  size_t tiles, size_t tile_stride, size_t half, double* out) {
+// Two tiles of 8 angles per pass over G take 20 registers of 8 doubles for the partial sums: the
+// AVX-512 kernel. GramEvaluate chooses the kernel.
+__attribute__((target("avx512f"))) void GramEvaluateAvx512(const double* ga, const double* gb, size_t stride, size_t terms,
+                                                           const double* tables, size_t tiles, size_t tile_stride,
+                                                           size_t half, double* out) {
   constexpr size_t T = AngularTables::kTile;
   constexpr size_t kPair = 2;
   const size_t n_out = 2 * half - 1;
@@ -208,6 +289,89 @@ void GramEvaluate(const double* ga, const double* gb, size_t stride, size_t term
       }
     }
   }
+}
+
+// EvaluateTiles<1> on lanes h .. h + 3 of one tile: 10 registers of 4 doubles for the partial
+// sums, within AVX2's 16 (the 8-lane form needs 40 there). A lane's operations are those of the
+// 8-lane form: the same bits.
+__attribute__((always_inline)) inline void EvaluateQuarterLanes(const double* ga, const double* gb, size_t stride, size_t terms,
+                                                                const double* tile, size_t h, V4* plus, V4* minus) {
+  constexpr size_t T = AngularTables::kTile;
+  constexpr size_t R = AngularTables::kRow;
+  const V4 zero = {0.0, 0.0, 0.0, 0.0};
+  *plus = *minus = zero;
+  for (int which = 0; which < 2; ++which) {
+    const double* g = which == 0 ? ga : gb;
+    const double* tp = tile + (which == 0 ? 0 : 2 * T) + h;
+    V4 acc_x = zero, acc_y = zero;
+    for (size_t row = 0; row < terms; ++row) {
+      const double* gr = g + row * stride;
+      V4 sx0 = zero, sx1 = zero, sx2 = zero, sx3 = zero, sy0 = zero, sy1 = zero, sy2 = zero, sy3 = zero;
+      size_t c = 0;
+      for (; c + 4 <= row; c += 4) {
+        const double* tt = tp + c * R;
+        const double g0 = gr[c], g1 = gr[c + 1], g2 = gr[c + 2], g3 = gr[c + 3];
+        sx0 += g0 * Load4(tt);
+        sy0 += g0 * Load4(tt + T);
+        sx1 += g1 * Load4(tt + R);
+        sy1 += g1 * Load4(tt + R + T);
+        sx2 += g2 * Load4(tt + 2 * R);
+        sy2 += g2 * Load4(tt + 2 * R + T);
+        sx3 += g3 * Load4(tt + 3 * R);
+        sy3 += g3 * Load4(tt + 3 * R + T);
+      }
+      for (; c < row; ++c) {
+        const double* tt = tp + c * R;
+        sx0 += gr[c] * Load4(tt);
+        sy0 += gr[c] * Load4(tt + T);
+      }
+      const double gd = gr[row];
+      const double* tt = tp + row * R;
+      const V4 sx = (sx0 + sx1) + (sx2 + sx3), sy = (sy0 + sy1) + (sy2 + sy3);
+      const V4 x = Load4(tt), y = Load4(tt + T);
+      acc_x += x * (gd * x + 2.0 * sx);
+      acc_y += y * (gd * y + 2.0 * sy);
+    }
+    *plus += acc_x;
+    *minus += acc_y;
+  }
+}
+
+__attribute__((always_inline)) inline void GramEvaluateLanes4(const double* ga, const double* gb, size_t stride, size_t terms,
+                                                              const double* tables, size_t tiles, size_t tile_stride,
+                                                              size_t half, double* out) {
+  constexpr size_t T = AngularTables::kTile;
+  const size_t n_out = 2 * half - 1;
+  for (size_t k = 0; k < tiles; ++k) {
+    for (size_t h = 0; h < T; h += 4) {
+      if (k * T + h >= half) break;
+      V4 plus, minus;
+      EvaluateQuarterLanes(ga, gb, stride, terms, tables + k * tile_stride, h, &plus, &minus);
+      for (size_t l = 0; l < 4; ++l) {
+        const size_t j = k * T + h + l;
+        if (j >= half) break;
+        out[j] = 0.25 * plus[l];
+        if (j + 1 < half) out[n_out - 1 - j] = 0.25 * minus[l];
+      }
+    }
+  }
+}
+__attribute__((target("avx2"))) void GramEvaluateAvx2(const double* ga, const double* gb, size_t stride, size_t terms,
+                                                      const double* tables, size_t tiles, size_t tile_stride, size_t half,
+                                                      double* out) {
+  GramEvaluateLanes4(ga, gb, stride, terms, tables, tiles, tile_stride, half, out);
+}
+void GramEvaluateBaseline(const double* ga, const double* gb, size_t stride, size_t terms, const double* tables, size_t tiles,
+                          size_t tile_stride, size_t half, double* out) {
+  GramEvaluateLanes4(ga, gb, stride, terms, tables, tiles, tile_stride, half, out);
+}
+
+void GramEvaluate(const double* ga, const double* gb, size_t stride, size_t terms, const double* tables, size_t tiles,
+                  size_t tile_stride, size_t half, double* out) {
+  static const int isa = __builtin_cpu_supports("avx512f") ? 2 : __builtin_cpu_supports("avx2") ? 1 : 0;
+  if (isa == 2) GramEvaluateAvx512(ga, gb, stride, terms, tables, tiles, tile_stride, half, out);
+  else if (isa == 1) GramEvaluateAvx2(ga, gb, stride, terms, tables, tiles, tile_stride, half, out);
+  else GramEvaluateBaseline(ga, gb, stride, terms, tables, tiles, tile_stride, half, out);
 }
 #pragma GCC diagnostic pop
 

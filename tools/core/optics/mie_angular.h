@@ -96,4 +96,28 @@ class IntensityAccumulator {
   std::vector<size_t> slot_len_;  // entries of each slot that may be non-zero
 };
 
+namespace detail {
+// The Gram update's kernels (mie_angular.cpp; IntensityAccumulator calls the one the CPU
+// supports): the 4 x 16 tile for AVX-512 and the 4 x 4 tile for AVX2 and baseline x86-64. They
+// give the same bits (tests/optics/mie_angular_test.cpp). G += sum over the count radii of
+// w (x x^T + y y^T), lower triangle, rows < terms; buf and wbuf as in IntensityAccumulator.
+__attribute__((target("avx512f"))) void GramUpdateAvx512(double* ga, double* gb, size_t stride, size_t terms,
+                                                         const double* buf, const double* wbuf, size_t count);
+__attribute__((target("avx2"))) void GramUpdateAvx2(double* ga, double* gb, size_t stride, size_t terms, const double* buf,
+                                                    const double* wbuf, size_t count);
+void GramUpdateBaseline(double* ga, double* gb, size_t stride, size_t terms, const double* buf, const double* wbuf,
+                        size_t count);
+// The evaluation's kernels (two 8-angle tiles per pass over G for AVX-512, 4 angles per pass for
+// AVX2 and baseline; the same bits): out = the size-averaged |S1|^2 + |S2|^2 at every grid
+// angle from G (rows < terms) and the tables' tiles.
+__attribute__((target("avx512f"))) void GramEvaluateAvx512(const double* ga, const double* gb, size_t stride, size_t terms,
+                                                           const double* tables, size_t tiles, size_t tile_stride,
+                                                           size_t half, double* out);
+__attribute__((target("avx2"))) void GramEvaluateAvx2(const double* ga, const double* gb, size_t stride, size_t terms,
+                                                      const double* tables, size_t tiles, size_t tile_stride, size_t half,
+                                                      double* out);
+void GramEvaluateBaseline(const double* ga, const double* gb, size_t stride, size_t terms, const double* tables, size_t tiles,
+                          size_t tile_stride, size_t half, double* out);
+}  // namespace detail
+
 }  // namespace skybake::mie
