@@ -16,10 +16,11 @@ namespace skybake::orders {
 constexpr double kPi = std::numbers::pi;
 constexpr double kDeg = kPi / 180.0;
 
-// The solve's tables (a field over every cell and wavelength: 178 MB for high) in vectors whose
-// elements start uninitialised, zeroed in parallel by ZeroTable: a std::vector<float> of that
-// size is zeroed on one thread, and so is the kernel's zeroing of the fresh pages on first touch
-// (~1.8 GB for high, ~2.5 s of system time at 2 threads). The same values, the same bytes.
+// The solve's tables (a field over every cell and wavelength: 88 MB for high's daylight part) in
+// vectors whose elements start uninitialised, zeroed in parallel by ZeroTable: a
+// std::vector<float> of that size is zeroed on one thread, and so is the kernel's zeroing of the
+// fresh pages on first touch (seconds of system time for high's fields and kernels). The same
+// values, the same bytes.
 template <class T>
 struct UninitAllocator : std::allocator<T> {
   template <class U>

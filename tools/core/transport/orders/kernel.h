@@ -57,7 +57,7 @@ struct ScatterKernels {
   size_t nm = 0;               // modes: nphi
   std::vector<float> cos_mq;   // cos(m theta_q) [m * nphi + q]
   size_t modal_floats = 0;     // G[((m * nu + k) * nu + k2) * nw + w] per radius
-  size_t end_floats = 0;       // D[(((e * nu + k) * nphi + q) * nu + k2) * nw + w] per radius
+  size_t end_floats = 0;       // D[((k * nphi + q) * nu + k2) * nw + w] per radius (both ends: modal_kernel.cpp)
   Table modal_kernels, end_kernels;
   size_t kernel_floats = 0;    // the matrix: nd x nd x nw per radius
   std::vector<float> kernels;  // empty: rebuilt per order

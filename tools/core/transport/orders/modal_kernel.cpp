@@ -8,10 +8,14 @@
 // nphi). Per radius and sun node nu^2 nphi + 2 nu nphi^2 products instead of (nu nphi)^2: 10x
 // fewer for high (36 view x 24 azimuth nodes), whose matrix would not fit in memory. The basis
 // kernel's azimuth hats are translates of one another except in the two end intervals, where the
-// even blend (Nodes::AzimuthBlend) departs from the linear one: that difference is kept as two
-// explicit columns per view node, D_e(k, q, k2) applied to L(k2, q0) - L(k2, q0 + 1) (q0 = 0 and
-// nphi - 2). The same values as the matrix to float rounding (test
-// MethodOrders.ModalKernelIsTheMatrixKernel).
+// even blend (Nodes::AzimuthBlend) departs from the linear one: that difference is kept as
+// explicit columns per view node, D(k, q, k2) applied to L(k2, 0) - L(k2, 1) at the end by phi = 0
+// and, mirrored, D(k, nphi - 1 - q, k2) applied to L(k2, nphi - 1) - L(k2, nphi - 2) at the end by
+// phi = pi. The mirror is exact: with psi = pi - phi the even and the linear weights of the far
+// interval are those of the near one at psi, the node azimuths map onto each other (theta_q ->
+// pi - theta_q), and the phase depends only on cos(theta_q -+ phi), which the map keeps; so one
+// end's columns serve both (half of D: 9 MB per radius for high instead of 18 MB). The same
+// values as the matrix to float rounding (test MethodOrders.ModalKernelIsTheMatrixKernel).
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -44,7 +48,7 @@ void CoefficientsAtNodes(const KernelContext& kc, const ViewNodes& vn, const std
 // The same for the basis kernel (ForEachViewSubsample's quadrature, as the matrix's): azimuth
 // sub-samples phi_a = (a + 1/2) u, u = pi / (2 sub nphi); the linear hat of node 0 is
 // 1 - |e| / (2 sub) at phi_a - theta_0 = e u, so c(d) = u sum_e hat(e) P(cos((2 sub d - e) u)).
-// With has_ends, dc gets the end columns (before their scaling).
+// With has_ends, dc gets the end columns of the end by phi = 0 (before their scaling).
 void CoefficientsOfBasis(const KernelContext& kc, double r, const ViewNodes& vn, const std::vector<float>& mix, bool has_ends,
                          std::vector<double>* c, std::vector<double>* dc) {
   const OrdersSettings& s = *kc.s;
@@ -54,7 +58,7 @@ void CoefficientsOfBasis(const KernelContext& kc, double r, const ViewNodes& vn,
   const double u = kPi / static_cast<double>(na);
   // The end intervals' departure of the even blend from the linear one at each sub-sample.
   struct EndSample {
-    size_t a, e;
+    size_t a;
     double dw;  // (linear - even) weight of the interval's lower node
   };
   std::vector<EndSample> ends;
@@ -62,7 +66,7 @@ void CoefficientsOfBasis(const KernelContext& kc, double r, const ViewNodes& vn,
     for (size_t a = 0; a < na; ++a) {
       size_t q0, q1;
       const double te = kc.nodes->AzimuthBlend((a + 0.5) * u, true, &q0), tl = kc.nodes->AzimuthBlend((a + 0.5) * u, false, &q1);
-      if (te != tl) ends.push_back({a, q0 == 0 ? size_t{0} : size_t{1}, tl - te});
+      if (te != tl && q0 == 0) ends.push_back({a, tl - te});
     }
   }
   std::vector<double> hat(2 * per);
@@ -89,7 +93,7 @@ void CoefficientsOfBasis(const KernelContext& kc, double r, const ViewNodes& vn,
         const long dlt = static_cast<long>(q * per + static_cast<size_t>(sub)) - static_cast<long>(es.a);
         const size_t md = static_cast<size_t>(dlt >= 1 ? dlt - 1 : -dlt), ms = q * per + static_cast<size_t>(sub) + es.a;
         for (int x = 0; x < 2; ++x) {
-          double* o = &(*dc)[(((es.e * nu + k) * nphi + q) * nu + kn[x]) * nw];
+          double* o = &(*dc)[((k * nphi + q) * nu + kn[x]) * nw];
           const double wgt = wk[x] * es.dw;
           for (size_t w = 0; w < nw; ++w) o[w] += wgt * (pm[md * nw + w] + pm[ms * nw + w]);
         }
@@ -134,12 +138,10 @@ void ModesFromCoefficients(const KernelContext& kc, size_t ri, const std::vector
       }
     }
     if (D == nullptr) continue;
-    for (size_t e = 0; e < 2; ++e) {
-      for (size_t q = 0; q < nphi; ++q) {
-        for (size_t k2 = 0; k2 < nu; ++k2) {
-          const size_t o = (((e * nu + k) * nphi + q) * nu + k2) * nw;
-          for (size_t w = 0; w < nw; ++w) D[o + w] = static_cast<float>(scale[w] * dc[o + w]);
-        }
+    for (size_t q = 0; q < nphi; ++q) {
+      for (size_t k2 = 0; k2 < nu; ++k2) {
+        const size_t o = ((k * nphi + q) * nu + k2) * nw;
+        for (size_t w = 0; w < nw; ++w) D[o + w] = static_cast<float>(scale[w] * dc[o + w]);
       }
     }
   }
@@ -169,7 +171,7 @@ void BuildModalKernels(const KernelContext& kc, ScatterKernels* sk) {
   }
   sk->has_ends = s.kernel_sub > 0 && s.azimuth_even;
   sk->modal_floats = sk->nm * nu * nu * nw;
-  sk->end_floats = sk->has_ends ? 2 * nu * nphi * nu * nw : 0;
+  sk->end_floats = sk->has_ends ? nu * nphi * nu * nw : 0;
   ZeroTable(&sk->modal_kernels, nr * sk->modal_floats);
   ZeroTable(&sk->end_kernels, nr * sk->end_floats);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nr, 1), [&](const tbb::blocked_range<size_t>& rg) {
@@ -182,9 +184,10 @@ void BuildModalKernels(const KernelContext& kc, ScatterKernels* sk) {
 // The three products run 8 wavelengths wide (simd.h), each sum in the order of the plain loops
 // (analysis: q ascending; modes: k2 ascending; synthesis: m ascending, then the end columns e, k2
 // ascending). Tasks (radius, block of up to 16 sun nodes): G (nm nu^2 nw floats per radius, 9 MB
-// for high) and D (twice that) do not fit in cache and are read once per task; within a task each
-// G or D slice (nu nw floats) serves the 4 sub-blocks of 4 sun nodes while in L1 (with tasks of 4
-// sun nodes high's scatter is bound by reading G and D, 27 MB per radius, 11 times per order).
+// for high) and D (as much, read once per end) do not fit in cache and are read once per task;
+// within a task each G or D slice (nu nw floats) serves the 4 sub-blocks of 4 sun nodes while in
+// L1 (with tasks of 4 sun nodes high's scatter is bound by reading G once and D twice, 27 MB per
+// radius, 11 times per order).
 void ScatterModal(const KernelContext& kc, const ScatterKernels& sk, const Table& Lin, Table* Jout) {
   const size_t nw = kc.md->nw, nu = kc.nodes->nu, ns = kc.nodes->ns, nphi = static_cast<size_t>(kc.s->nphi);
   const size_t nr = kc.nodes->radius.size(), nd = kc.nd, nm = sk.nm;
@@ -208,12 +211,13 @@ void ScatterModal(const KernelContext& kc, const ScatterKernels& sk, const Table
         for (size_t k2 = 0; k2 < nu; ++k2) {
           ModalAnalysis(&lin[k2 * nphi * nw], sk.cos_mq.data(), nm, nphi, nw, &S[b * sb + k2 * nw], nu * nw);
           if (!has_ends) continue;
-          for (size_t e = 0; e < 2; ++e) {
-            const size_t q0 = e == 0 ? 0 : nphi - 2;
-            const float* l0 = &lin[(k2 * nphi + q0) * nw];
-            float* dv = &dL[b * db + (e * nu + k2) * nw];
-            for (size_t w = 0; w < nw; ++w) dv[w] = l0[w] - l0[nw + w];
-          }
+          // L(0) - L(1) at the near end, L(nphi - 1) - L(nphi - 2) at the far one (the mirror).
+          const float* l0 = &lin[k2 * nphi * nw];
+          const float* l1 = &lin[(k2 * nphi + nphi - 2) * nw];
+          float* d0 = &dL[b * db + k2 * nw];
+          float* d1 = &dL[b * db + (nu + k2) * nw];
+          for (size_t w = 0; w < nw; ++w) d0[w] = l0[w] - l0[nw + w];
+          for (size_t w = 0; w < nw; ++w) d1[w] = l1[nw + w] - l1[w];
         }
       }
       // Modes: T[b][k][m] = sum_k2 G_m(k, k2) S[b][m][k2].
@@ -232,7 +236,8 @@ void ScatterModal(const KernelContext& kc, const ScatterKernels& sk, const Table
             ModalSynthesis4(&sk.cos_mq[q], nphi, &T[u * kSub * tb + k * nm * nw], tb, nm, nw, acc.data());
             if (has_ends) {
               for (size_t e = 0; e < 2; ++e) {
-                const float* Dv = &sk.end_kernels[ri * sk.end_floats + (((e * nu + k) * nphi + q) * nu) * nw];
+                const size_t qe = e == 0 ? q : nphi - 1 - q;
+                const float* Dv = &sk.end_kernels[ri * sk.end_floats + ((k * nphi + qe) * nu) * nw];
                 ModalBlock4Add(Dv, nw, &dL[u * kSub * db + e * nu * nw], nw, db, nu, nw, acc.data());
               }
             }

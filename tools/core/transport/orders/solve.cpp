@@ -3,7 +3,9 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include <fmt/format.h>
 
@@ -60,7 +62,7 @@ void FirstOrder(const AtmosphereModel& m, const Medium& md, const SunTables& sun
           }
           for (size_t w = 0; w < nw; ++w) acc[w] += f.wt[st * nw + w] * src[w] * tsun[w] * static_cast<float>(md.sun_e[w]);
           if (!tc->sun_az.empty()) {
-            tc->sun_az[nodes.Cell(ri, si, k, q) * nt + st] = StepSunAzimuth(nodes, tc->s->azimuth_even, f, st, r, ts, nu_s);
+            tc->sun_az[nodes.Cell(ri, si, k, q) * nt + st] = PackSunAzimuth(StepSunAzimuth(nodes, tc->s->azimuth_even, f, st, r, ts, nu_s));
           }
         }
         if (f.ground) AddGroundReflection(nodes, md, f, r, ts, nu_s, E0, eg.data(), acc.data());
@@ -70,10 +72,27 @@ void FirstOrder(const AtmosphereModel& m, const Medium& md, const SunTables& sun
   });
 }
 
-// The radiance tables of the iteration: L = L_{n-1} while order n is computed into Lnext;
-// Lprev = L_{n-2} (for the ratio tests); J the sources of order n.
+// The per-element ratio L_{n-1} / L_{n-2} that the tail's test needs (AddTail), one byte per
+// element instead of the table L_{n-2} itself (a quarter of a table: 23 MB instead of 93 MB for
+// high's daylight part): kRatioNone where the ratio is not below 1 or L_{n-2} is not positive
+// (the test fails there whatever L_n), else floor(254 r), read back as the bin's centre (c +
+// 1/2) / 254, within 1/508 of r. The test compares it with L_n / L_{n-1} at a threshold of 0.05,
+// so only an element within 0.002 of that threshold can take the other of its two acceptable
+// ratios (its own or the observer's).
+constexpr uint8_t kRatioNone = 255;
+inline uint8_t RatioCode(float now, float before) {
+  if (!(before > 0.0f)) return kRatioNone;
+  const double r = now / static_cast<double>(before);
+  if (!(r < 1.0)) return kRatioNone;
+  return static_cast<uint8_t>(std::min(253.0, std::floor(std::max(0.0, r) * 254.0)));
+}
+inline double RatioOfCode(uint8_t c) { return (c + 0.5) / 254.0; }
+
+// The tables of the iteration: L = L_{n-1} while order n is computed into Lnext; J the sources
+// of order n; ratio the code of L_{n-1} / L_{n-2} per element (for the tail's test).
 struct OrderTables {
-  Table L, J, Lnext, Lprev;
+  Table L, J, Lnext;
+  std::vector<uint8_t> ratio;
 };
 
 // The ratio history of the stopping rule (norms of successive orders at the observer, reference
@@ -108,14 +127,14 @@ bool TakeTail(const OrdersSettings& s, int order, double fraction, double ratio,
 // L_{n-1} / L_{n-2} agree within 0.05 and are below 1, the observer's global ratio elsewhere (an
 // element whose orders still grow - the low-sun horizon's at order 4 - would get a tail of 9 L_n
 // from its own ratio and come out 60 % bright). The sources J_n decay like the radiances of their
-// node. rho is capped at rho_cap (0.98: tail <= 49 L_n). Here L = L_n, Lprev = L_{n-1}, Lnext =
-// L_{n-2}.
+// node. rho is capped at rho_cap (0.98: tail <= 49 L_n). Here Lnext = L_n, L = L_{n-1} and
+// ratio codes L_{n-1} / L_{n-2}.
 void AddTail(const Nodes& nodes, const OrdersSettings& s, size_t nd, double ratio, const OrderTables& t, SolveResult* out) {
   const size_t nw = nodes.nw, ns = nodes.ns;
   auto tail_at = [&](size_t e) {
-    const double r1 = t.Lprev[e] > 0.0f ? t.L[e] / static_cast<double>(t.Lprev[e]) : 2.0;
-    const double r0 = t.Lnext[e] > 0.0f ? t.Lprev[e] / static_cast<double>(t.Lnext[e]) : 2.0;
-    double rho = r1 < 1.0 && r0 < 1.0 && std::abs(r1 - r0) < 0.05 ? r1 : ratio;
+    const double r1 = t.L[e] > 0.0f ? t.Lnext[e] / static_cast<double>(t.L[e]) : 2.0;
+    const uint8_t c0 = t.ratio[e];
+    double rho = r1 < 1.0 && c0 != kRatioNone && std::abs(r1 - RatioOfCode(c0)) < 0.05 ? r1 : ratio;
     rho = std::clamp(rho, 0.0, s.rho_cap);
     return static_cast<float>(rho / (1.0 - rho));
   };
@@ -123,7 +142,7 @@ void AddTail(const Nodes& nodes, const OrdersSettings& s, size_t nd, double rati
     for (size_t i = 0; i < nd; ++i) {
       const size_t e0 = (((nodes.obs_index * ns + si) * nd) + i) * nw;
       float* a = &out->ms[((si * nd) + i) * nw];
-      for (size_t w = 0; w < nw; ++w) a[w] += tail_at(e0 + w) * t.L[e0 + w];
+      for (size_t w = 0; w < nw; ++w) a[w] += tail_at(e0 + w) * t.Lnext[e0 + w];
     }
   }
   tbb::parallel_for(tbb::blocked_range<size_t>(0, out->jms.size(), size_t{1} << 18), [&](const tbb::blocked_range<size_t>& rg) {
@@ -158,8 +177,14 @@ SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, 
   const size_t cells = nr * nodes.ns * nodes.nu * nphi;
   const std::vector<Family> fam = BuildFamilies(m, md, nodes, s);
   TransportContext tc = MakeTransportContext(m, md, nodes, s, fam);
+  // The kernels before the tables: their build's scratch (two radii's double coefficients per
+  // thread, 107 MB at 2 threads for high) is freed before the tables are touched, so it adds
+  // nothing to the peak.
+  const KernelContext kc = MakeKernelContext(md, nodes, s);
+  const ScatterKernels sk = BuildScatterKernels(kc);
   OrderTables t;
-  for (Table* x : {&t.L, &t.J, &t.Lnext, &t.Lprev}) ZeroTable(x, cells * nw);
+  for (Table* x : {&t.L, &t.J, &t.Lnext}) ZeroTable(x, cells * nw);
+  t.ratio.assign(cells * nw, kRatioNone);  // no L_0: the test fails at order 2
   ReportProgress(progress, "orders: order 1", 0.0);
   FirstOrder(m, md, sun, &tc, &t.L);
 
@@ -167,8 +192,6 @@ SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, 
   out.ms.assign(nodes.ns * nodes.nu * nphi * nw, 0.0f);
   ZeroTable(&out.jms, cells * nw);
   const size_t nd = nodes.nu * nphi;  // directions per (radius, sun)
-  const KernelContext kc = MakeKernelContext(md, nodes, s);
-  const ScatterKernels sk = BuildScatterKernels(kc);
   RatioHistory h;
   for (int order = 2; order <= s.max_orders; ++order) {
     ReportProgress(progress, fmt::format("orders: order {}", order), 0.0);
@@ -177,12 +200,9 @@ SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, 
       for (size_t i = rg.begin(); i != rg.end(); ++i) out.jms[i] += t.J[i];
     });
     Transport(tc, t.J, t.L, &t.Lnext);
-    // Rotate: L = L_n, Lprev = L_{n-1}, Lnext = L_{n-2}.
-    std::swap(t.Lprev, t.L);
-    std::swap(t.L, t.Lnext);
-    // Accumulate at the observer radius; convergence on the reference wavelength.
+    // Accumulate L_n (Lnext) at the observer radius; convergence on the reference wavelength.
     double total = 0.0;
-    const double norm = AccumulateAtObserver(nodes, nd, t.L, &out.ms, &total);
+    const double norm = AccumulateAtObserver(nodes, nd, t.Lnext, &out.ms, &total);
     out.orders_done = order;
     out.last_fraction = total > 0.0 ? norm / total : 0.0;
     const double ratio = h.prev_norm > 0.0 ? norm / h.prev_norm : -1.0;
@@ -194,6 +214,11 @@ SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, 
     h.prev_prev_ratio = h.prev_ratio;
     h.prev_ratio = ratio;
     h.prev_norm = norm;
+    // Next order: ratio codes L_n / L_{n-1}, then L = L_n.
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, t.ratio.size(), size_t{1} << 18), [&](const tbb::blocked_range<size_t>& rg) {
+      for (size_t i = rg.begin(); i != rg.end(); ++i) t.ratio[i] = RatioCode(t.Lnext[i], t.L[i]);
+    });
+    std::swap(t.L, t.Lnext);
   }
   return out;
 }

@@ -16,7 +16,7 @@ TransportContext MakeTransportContext(const AtmosphereModel& m, const Medium& md
   tc.m = &m, tc.md = &md, tc.nodes = &nodes, tc.s = &s, tc.fam = &fam;
   tc.nd = nodes.nu * static_cast<size_t>(s.nphi);
   const size_t cells = nodes.radius.size() * nodes.ns * tc.nd, nt = static_cast<size_t>(s.nt);
-  if (cells * nt * sizeof(SunAzimuth) <= (size_t{768} << 20)) tc.sun_az.resize(cells * nt);
+  if (cells * nt * sizeof(PackedSunAzimuth) <= (size_t{768} << 20)) tc.sun_az.resize(cells * nt);
   tc.loglin_first = nodes.ns;
   for (size_t si = 0; si + 1 < nodes.ns; ++si) {
     if (s.sun_deg[si] >= s.loglin_from_deg - 1e-9) {
@@ -28,10 +28,10 @@ TransportContext MakeTransportContext(const AtmosphereModel& m, const Medium& md
 }
 
 SunAzimuth TransportContext::StepPosition(const Family& f, size_t step, size_t ri, size_t si, size_t k, size_t q) const {
-  if (!sun_az.empty()) return sun_az[nodes->Cell(ri, si, k, q) * static_cast<size_t>(s->nt) + step];
+  if (!sun_az.empty()) return UnpackSunAzimuth(sun_az[nodes->Cell(ri, si, k, q) * static_cast<size_t>(s->nt) + step]);
   double mu, nu;
   nodes->CellGeometry(ri, si, k, q, &mu, &nu);
-  return StepSunAzimuth(*nodes, s->azimuth_even, f, step, nodes->radius[ri], nodes->sun_theta_rad[si], nu);
+  return UnpackSunAzimuth(PackSunAzimuth(StepSunAzimuth(*nodes, s->azimuth_even, f, step, nodes->radius[ri], nodes->sun_theta_rad[si], nu)));
 }
 
 void GroundIrradiance(const Nodes& nodes, int ndn, const Table& L, std::vector<float>* E) {
