@@ -34,18 +34,17 @@ AngularTables::AngularTables(const PhaseGrid& grid, int max_terms)
 namespace detail {
 
 // Eight doubles as one value (GCC vector extension): explicit lanes, so every lane does the same
-// operations in the same order whatever the instruction set (one AVX-512 register, two AVX2
-// registers or four SSE2 registers).
-// (Always inlined into each clone; GCC's -Wpsabi note about passing such values between
+// operations in the same order whatever the instruction set: the AVX-512 kernels' lanes.
+// (Always inlined into each kernel; GCC's -Wpsabi note about passing such values between
 // functions compiled for different targets therefore does not apply.)
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"
 typedef double V8 __attribute__((vector_size(64)));
 
 #if defined(__clang__)
-// clang (the sanitizer and fuzz build, docs/developing.md) refuses a 64-byte vector returned by a
-// function inside the avx2 clone even when it is always inlined ("changes the ABI"): there the
-// two helpers are expressions. The lanes and their operations are the same.
+// clang (the sanitizer and fuzz build, docs/developing.md) refuses a wide vector returned by a
+// function inside a narrower target even when it is always inlined ("changes the ABI"): there the
+// helpers are expressions. The lanes and their operations are the same.
 typedef double V8Unaligned __attribute__((vector_size(64), aligned(8)));
 #define Load8(p) (*reinterpret_cast<const V8Unaligned*>(p))
 #define Splat8(x) (V8{(x), (x), (x), (x), (x), (x), (x), (x)})
