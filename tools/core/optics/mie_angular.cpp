@@ -139,8 +139,8 @@ __attribute__((always_inline)) inline V4 Load4(const double* p) {
 
 // GramUpdateAvx512's sums in tiles of 4 rows x 4 columns: the two matrices' tiles take 8
 // registers of 4 doubles and the radius' columns 4, within AVX2's 16 (the 4 x 16 tile there
-// needs 48 and spends its time spilling them: the water cloud's table took 7-9x longer on an
-// AVX2 machine). Every element gets the same operations in the same order as in the 4 x 16 tile
+// needs 48 and spends its time spilling them: the water cloud's table takes 5x as long with it on
+// an AVX2 machine, docs/mie.md). Every element gets the same operations in the same order as in the 4 x 16 tile
 // (G + (w_re x_re + w_im x_im), radius after radius; no fused multiply-add): the same bits on any
 // CPU (tests/optics/mie_angular_test.cpp). Columns past the diagonal and rows past `terms` are
 // padding, as there.
