@@ -194,8 +194,14 @@ void GramUpdateBaseline(double* ga, double* gb, size_t stride, size_t terms, con
   GramUpdateTiles4(ga, gb, stride, terms, buf, wbuf, count);
 }
 
+// The kernels' instruction set on this CPU, read once: 2 AVX-512, 1 AVX2, 0 baseline x86-64.
+int KernelLevel() {
+  static const int level = __builtin_cpu_supports("avx512f") ? 2 : __builtin_cpu_supports("avx2") ? 1 : 0;
+  return level;
+}
+
 void GramUpdate(double* ga, double* gb, size_t stride, size_t terms, const double* buf, const double* wbuf, size_t count) {
-  static const int isa = __builtin_cpu_supports("avx512f") ? 2 : __builtin_cpu_supports("avx2") ? 1 : 0;
+  const int isa = KernelLevel();
   if (isa == 2) GramUpdateAvx512(ga, gb, stride, terms, buf, wbuf, count);
   else if (isa == 1) GramUpdateAvx2(ga, gb, stride, terms, buf, wbuf, count);
   else GramUpdateBaseline(ga, gb, stride, terms, buf, wbuf, count);
@@ -367,7 +373,7 @@ void GramEvaluateBaseline(const double* ga, const double* gb, size_t stride, siz
 
 void GramEvaluate(const double* ga, const double* gb, size_t stride, size_t terms, const double* tables, size_t tiles,
                   size_t tile_stride, size_t half, double* out) {
-  static const int isa = __builtin_cpu_supports("avx512f") ? 2 : __builtin_cpu_supports("avx2") ? 1 : 0;
+  const int isa = KernelLevel();
   if (isa == 2) GramEvaluateAvx512(ga, gb, stride, terms, tables, tiles, tile_stride, half, out);
   else if (isa == 1) GramEvaluateAvx2(ga, gb, stride, terms, tables, tiles, tile_stride, half, out);
   else GramEvaluateBaseline(ga, gb, stride, terms, tables, tiles, tile_stride, half, out);
