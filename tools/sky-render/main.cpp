@@ -6,6 +6,8 @@
 //              [--sun-zenith-deg 30,70,85,90,94 | --time-mapping gt7] [--target-error 0.01] [--preview sky.png] ...
 //   sky-render points ATMOSPHERE.yaml --geometry in.csv -o out.csv [--wavelengths-out 440,550,680]
 //   sky-render budget ATMOSPHERE.yaml -o budget.csv [--tolerance 1%] [--method ms-approx] ...
+//   sky-render choose ATMOSPHERE.yaml -o quality.yaml [--tolerance 0.5%] [--max-tolerance 2%] ...
+//              then   sky-render render ATMOSPHERE.yaml --settings quality.yaml ...   (quality: auto)
 //   sky-render fog ATMOSPHERE.yaml -o fog.exr [--method orders|path] [--cut-altitude-km 1] ... (docs/fog.md)
 //   sky-render render ... --shard K/N -o part_K.exr   then   sky-render merge part_*.exr -o sky.exr [--preview sky.png]
 //   sky-render fog ... --shard K/N -o part_K.exr      then   sky-render merge part_*.exr -o fog.exr
@@ -36,6 +38,7 @@
 #include "lut/directions.h"
 #include "spectrum/cmf.h"
 #include "spectrum/xyz.h"
+#include "transport/auto_quality.h"
 #include "transport/budget.h"
 #include "transport/path_tracer.h"
 #include "transport/points.h"
@@ -112,6 +115,11 @@ int main(int argc, char** argv) {
                      "Deterministic methods: run on every k-th wavelength (and the last), the transfer "
                      "interpolated to the grid (docs/sky-methods.md)")
       ->default_val(1);
+  std::string settings_file;
+  CLI::Option* settings_opt = render->add_option(
+      "--settings", settings_file,
+      "Method, quality and spectral stride from a file of sky-render choose (quality: auto; docs/sky-methods.md "
+      "\"Automatic quality\"), recorded in the provenance");
   render->add_option("--mapping", ro.mapping, "Direction mapping: equirectangular, fisheye or gt7 (lut-pack's, docs/lut-pack.md)")->default_val("equirectangular");
   render->add_option("--size", ro.size, "Image size WxH")->default_val("64x32");
   CLI::Option* sza = render->add_option("--sun-zenith-deg", ro.sun_zenith_deg, "Sun zenith angles (deg), comma separated")
@@ -159,6 +167,20 @@ int main(int argc, char** argv) {
       ->delimiter(',')->default_str("30,70,85,90,94");
   budget->add_option("--altitude-range-m", altitude_range,
                      "Observer altitude range lo:hi (m) for the altitude dimension (default: the observer's + 0..300 m)");
+
+  CLI::App* choose = cli.app().add_subcommand(
+      "choose", "The cheapest quality and spectral stride of a deterministic method within tolerances of its full model "
+                "(quality: auto; docs/sky-methods.md \"Automatic quality\")");
+  add_scene_options(choose);
+  AutoQualityOptions ao;
+  std::string choose_rms = "0.5%", choose_max = "2%", choose_twilight = "3%";
+  choose->add_option("--tolerance", choose_rms, "Daylight RMS relative luminance error against the full model, e.g. 0.5% or 0.005")
+      ->default_val("0.5%");
+  choose->add_option("--max-tolerance", choose_max, "Daylight largest relative luminance error (outside a 1 deg aureole)")
+      ->default_val("2%");
+  choose->add_option("--twilight-tolerance", choose_twilight, "Twilight (sun zenith 92-100 deg) RMS relative luminance error")
+      ->default_val("3%");
+  choose->add_option("--method", ao.method, "Deterministic method: " + TextList(methods, ", "))->default_val("orders");
 
   CLI::App* fog = cli.app().add_subcommand(
       "fog", "Reference fog of the low atmosphere: GT7 fog LUT slices, depth tables, attenuation (docs/fog.md)");
@@ -304,8 +326,34 @@ int main(int argc, char** argv) {
       if (!depfile.empty()) WriteDepfile(depfile, output, rep.files_read);
       return;
     }
+    if (choose->parsed()) {
+      ao.tolerance_rms = ParseTolerance(choose_rms, "--tolerance");
+      ao.tolerance_max = ParseTolerance(choose_max, "--max-tolerance");
+      ao.twilight_tolerance_rms = ParseTolerance(choose_twilight, "--twilight-tolerance");
+      const AutoQualityChoice ch = ChooseQuality(scene, ao, cli.Progress());
+      WriteFileIfChanged(output, AutoQualityYaml(ch));
+      std::fputs(AutoQualityTable(ch).c_str(), stdout);
+      if (!depfile.empty()) WriteDepfile(depfile, output, ch.files_read);
+      return;
+    }
+    std::vector<fs::path> extra_read;
+    if (render->parsed() && settings_opt->count() > 0) {
+      for (const char* o : {"--quality", "--spectral-stride"}) {
+        if (render->count(o) > 0) throw UsageError(std::string(o) + ": not with --settings (the file says it)");
+      }
+      const AutoQualitySettings set = ReadAutoQualitySettings(settings_file);
+      if (render->count("--method") > 0 && ro.method != set.method) {
+        throw UsageError(fmt::format("--method {}: {} is a choice for method {}", ro.method, settings_file, set.method));
+      }
+      ro.method = set.method;
+      ro.method_options.quality = set.quality;
+      ro.method_options.spectral_stride = set.stride;
+      ro.quality_choice = set.provenance;
+      extra_read.push_back(settings_file);
+    }
     // Load and validate (every input file is recorded for the depfile).
     Scene s = LoadScene(scene, cli.Progress());
+    s.files_read.insert(s.files_read.end(), extra_read.begin(), extra_read.end());
     if (render->parsed() && !ro.preview.empty()) CheckPreviewOptions(s, ro);
     if (render->parsed()) {
       RenderProducts p = RenderProductsOf(s, ro, cli.Progress());

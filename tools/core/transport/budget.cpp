@@ -48,7 +48,7 @@ struct Evaluator {
 
 }  // namespace
 
-double ParseTolerance(const std::string& text) {
+double ParseTolerance(const std::string& text, const std::string& option) {
   std::string t;
   for (char c : text) {
     if (c != ' ') t += c;
@@ -61,7 +61,7 @@ double ParseTolerance(const std::string& text) {
   double v = 0.0;
   const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
   if (t.empty() || r.ec != std::errc() || r.ptr != t.data() + t.size() || !(v > 0.0) || !std::isfinite(v)) {
-    throw UsageError("--tolerance: expected a positive number or percentage (e.g. 1% or 0.01), got '" + text + "'");
+    throw UsageError(option + ": expected a positive number or percentage (e.g. 1% or 0.01), got '" + text + "'");
   }
   return v * scale;
 }

@@ -73,7 +73,7 @@ BudgetReport RunBudget(const SceneOptions& scene, const BudgetOptions& options, 
 std::string BudgetCsv(const BudgetReport& report);
 std::string BudgetTable(const BudgetReport& report);
 
-// "1%", "0.5 %" or "0.01" -> 0.01; UsageError otherwise.
-double ParseTolerance(const std::string& text);
+// "1%", "0.5 %" or "0.01" -> 0.01; UsageError "<option>: ..." otherwise.
+double ParseTolerance(const std::string& text, const std::string& option = "--tolerance");
 
 }  // namespace skybake

@@ -223,7 +223,7 @@ void WriteRender(const Scene& scene, const RenderOptions& o, const RenderProduct
   prov.tool = tool;
   prov.parameters = fmt::format("method: {}\nmapping: {}\nsize: {}\n", o.method, o.mapping, o.size) +
                     (o.time_mapping.empty() ? "" : "time_mapping: " + o.time_mapping + "\n") +
-                    p.method_description + scene.parameters;
+                    p.method_description + (o.quality_choice.empty() ? "" : o.quality_choice + "\n") + scene.parameters;
   for (const fs::path& f : scene.files_read) prov.AddInput(f);
 
   ColorConfig config = ColorConfig::Load(scene.ocio_config);

@@ -82,6 +82,9 @@ struct RenderOptions {
   std::string display = "sRGB";
   std::string white = "auto";
   double exposure_stops = 0.0;
+  // "quality_choice: {...}" (transport/auto_quality.h): the automatic choice the method's quality
+  // and stride came from, a line of the provenance's parameters; "" when given by hand.
+  std::string quality_choice;
 };
 
 struct RenderProducts {
