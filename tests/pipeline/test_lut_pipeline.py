@@ -23,6 +23,8 @@ import struct
 import sys
 import unittest
 
+import yaml
+
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "cli"))
 from skytest import SRC, PipelineTestCase, TINY_PARTICLE, run, tool  # noqa: E402
 
@@ -203,6 +205,59 @@ class LutPipelineTest(PipelineTestCase):
         r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)
         self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
         self.assertRegex(r.stderr, r"pipeline\.yaml:17: .*quality")
+
+    def test_quality_auto_chooses_then_renders_with_the_choice(self):
+        # `quality: auto` (docs/sky-methods.md "Automatic quality"): a sky-render choose edge writes
+        # hazed/lut_quality.yaml, the render edge reads it, the report carries the choice and its
+        # measured error; an edit of the atmosphere re-chooses and re-renders, nothing else does.
+        self.edit("pipeline.yaml", "{atmosphere: hazed, size: 4x8}", "{atmosphere: hazed, size: 4x8, quality: auto, tolerance: 2%}")
+        r = self.bake()
+        ran = edges_run(r.stdout)
+        self.assertIn("sky-render hazed/lut_quality.yaml", ran)
+        self.assertNotIn("sky-render clear/lut_quality.yaml", ran)
+        with open(os.path.join(self.out, "build.ninja")) as f:
+            ninja = f.read()
+        edges = {m.group(1): m.group(2) for m in re.finditer(r"build (\w+)/lut_sky\.exr: .*\n  args = (.*)", ninja)}
+        self.assertIn("--settings hazed/lut_quality.yaml", edges["hazed"])
+        self.assertNotIn("--quality", edges["hazed"])
+        self.assertIn("--quality low", edges["clear"])
+        self.assertRegex(ninja, r"build hazed/lut_quality\.yaml: lut_choose hazed/components/render\.yaml \|.*\n  args = choose "
+                                r"--method single .*--tolerance 0\.02 --max-tolerance 0\.02 --twilight-tolerance 0\.03")
+        with open(os.path.join(self.out, "hazed", "lut_quality.yaml")) as f:
+            choice = yaml.safe_load(f)
+        self.assertEqual(choice["method"], "single")
+        self.assertLessEqual(choice["chosen"]["daylight_rms"], 0.02)
+        self.assertLessEqual(choice["chosen"]["daylight_max"], 0.02)
+        self.assertLessEqual(choice["chosen"]["twilight_rms"], 0.03)
+        with open(os.path.join(self.out, "luts", "report.json")) as f:
+            skies = {s["name"]: s for s in json.load(f)["skies"]}
+        q = skies["hazed"]["quality_choice"]
+        self.assertEqual((q["quality"], q["spectral_stride"]), (choice["quality"], choice["spectral_stride"]))
+        self.assertEqual(q["measured"]["daylight_rms"], choice["chosen"]["daylight_rms"])
+        self.assertEqual(q["tolerance"]["daylight_rms"], 0.02)
+        self.assertIsNone(skies["clear"]["quality_choice"])
+        self.assertIn("no work to do", self.ninja("-n").stdout)
+        self.assertIn("No missing dependencies", self.ninja("-t", "missingdeps").stdout)
+        self.edit("atmospheres/hazed.yaml", "optical_depth_550nm: 0.5", "optical_depth_550nm: 0.6")
+        ran = edges_run(self.ninja().stdout)
+        self.assertEqual(sorted(ran), sorted(["Regenerating build.ninja", "sky-render hazed/sky.exr", "sky-render hazed/lut_quality.yaml",
+                                              "sky-render hazed/lut_sky.exr", "lut-pack luts/report.json"]))
+
+    def test_quality_auto_errors_are_located(self):
+        for old, new, message in [
+                ("{atmosphere: hazed, size: 4x8}", "{atmosphere: hazed, size: 4x8, tolerance: 1%}",
+                 "pipeline.yaml:17: key 'luts.skies[1].tolerance': applies to quality: auto only"),
+                ("{atmosphere: hazed, size: 4x8}", "{atmosphere: hazed, size: 4x8, quality: auto, max_tolerance: lots}",
+                 "pipeline.yaml:17: key 'luts.skies[1].max_tolerance': expected a positive relative error"),
+                ("  quality: low\n", "  quality: automatic\n", "pipeline.yaml:13: key 'luts.quality': expected one of 'low', 'medium', 'high' or 'auto'")]:
+            with open(self.path("pipeline.yaml")) as f:
+                original = f.read()
+            self.assertIn(old, original)
+            self.write("pipeline.yaml", original.replace(old, new, 1))
+            r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)
+            self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
+            self.assertIn(message, r.stderr)
+            self.write("pipeline.yaml", original)
 
     def test_golden_reduced_bake(self):
         self.bake()

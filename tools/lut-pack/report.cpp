@@ -1,7 +1,9 @@
 #include "report.h"
 
 #include <nlohmann/json.hpp>
+#include <yaml-cpp/yaml.h>
 
+#include <charconv>
 #include <cmath>
 #include <numbers>
 
@@ -14,6 +16,35 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 constexpr double kDeg = std::numbers::pi / 180.0;
+
+// A YAML node as JSON: mappings, sequences, and scalars as numbers where the whole scalar is one.
+Json YamlToJson(const YAML::Node& n) {
+  if (n.IsMap()) {
+    Json j = Json::object();
+    for (const auto& kv : n) j[kv.first.as<std::string>()] = YamlToJson(kv.second);
+    return j;
+  }
+  if (n.IsSequence()) {
+    Json j = Json::array();
+    for (const auto& e : n) j.push_back(YamlToJson(e));
+    return j;
+  }
+  const std::string t = n.as<std::string>();
+  double v = 0.0;
+  const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+  if (!t.empty() && r.ec == std::errc() && r.ptr == t.data() + t.size()) return v;
+  return t;
+}
+
+// The render's automatic quality choice (sky-render choose), or null for a quality given by hand.
+Json QualityChoiceJson(const std::string& flow) {
+  if (flow.empty()) return nullptr;
+  try {
+    return YamlToJson(YAML::Load(flow));
+  } catch (const YAML::Exception&) {
+    return flow;  // the provenance as written, when it is no YAML mapping
+  }
+}
 
 Json StatsJson(const lut::PackStats& s) {
   Json j;
@@ -102,6 +133,7 @@ std::string PackReportJson(const lut::LutSet& set, const ReportContext& ctx) {
     s["name"] = p.name;
     s["render"] = r.path;
     s["method"] = r.method;
+    s["quality_choice"] = QualityChoiceJson(r.quality_choice);
     s["size"] = {{"width", r.width}, {"height", r.height}, {"slices", r.time.slices()}};
     s["texel_bytes"] = p.sky.bytes.size();
     s["scale"] = p.sky.scale;

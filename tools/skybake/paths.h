@@ -28,6 +28,8 @@ inline std::filesystem::path SkyPreview(const std::string& atm) { return std::fi
 
 // outputs/<atm>/lut_sky.exr: sky-render's render on the GT7 mappings for lut-pack.
 inline std::filesystem::path LutRender(const std::string& atm) { return std::filesystem::path(atm) / "lut_sky.exr"; }
+// outputs/<atm>/lut_quality.yaml: sky-render choose's settings of that render (quality: auto).
+inline std::filesystem::path LutQuality(const std::string& atm) { return std::filesystem::path(atm) / "lut_quality.yaml"; }
 // outputs/luts/report.json: lut-pack's report; the set's files lie beside it (LutFile).
 inline std::filesystem::path LutReport() { return std::filesystem::path("luts") / "report.json"; }
 inline std::filesystem::path LutFile(const std::string& name) { return std::filesystem::path("luts") / name; }

@@ -30,13 +30,19 @@ std::string Join(const std::vector<double>& v) {
 }
 
 // The `method: ...` line of the render's resolved parameters (provenance), for the report.
-std::string MethodOf(const ExrImage& img) {
+// The value of the first provenance line "<key>: value" of the render's parameters ("" if none).
+std::string ParameterOf(const ExrImage& img, const std::string& key) {
   const std::string* p = FindStringAttribute(img, "skybake.parameters");
   if (!p) return "";
-  const size_t at = p->find("method: ");
-  if (at == std::string::npos) return "";
+  const std::string tag = key + ": ";
+  size_t at = 0;
+  if (p->compare(0, tag.size(), tag) != 0) {
+    at = p->find("\n" + tag);
+    if (at == std::string::npos) return "";
+    ++at;
+  }
   const size_t end = p->find('\n', at);
-  return p->substr(at + 8, end == std::string::npos ? std::string::npos : end - at - 8);
+  return p->substr(at + tag.size(), end == std::string::npos ? std::string::npos : end - at - tag.size());
 }
 
 }  // namespace
@@ -126,7 +132,8 @@ SkyRender ReadSkyRender(const fs::path& path) {
     if (k == 0) r.observer = *obs;
     else if (*obs != r.observer) fail("part '" + pn + "' has another observer than the first slice");
   }
-  r.method = MethodOf(first);
+  r.method = ParameterOf(first, "method");
+  r.quality_choice = ParameterOf(first, "quality_choice");
 
   // Transmittance (wavelength x view zenith), direct sun (wavelength x sun zenith), irradiances.
   const ExrTable tr = ImageToTable(FindPart(parts, "transmittance", name), name);

@@ -45,6 +45,9 @@ struct SkyRender {
   std::vector<std::vector<float>> slice_xyz;  // per slice: W*H*3, CIE-XYZ-D65 (cd/m^2), rows top to bottom
   std::string observer;                       // e.g. "cie2006_2deg"
   std::string method;                         // the render's method line ("method: orders ...")
+  // The render's automatic quality choice (transport/auto_quality.h), the YAML flow mapping of its
+  // "quality_choice: {...}" provenance line; "" for a render whose quality was given by hand.
+  std::string quality_choice;
   std::vector<double> wavelength_nm;
   std::vector<double> transmittance_zenith_deg;
   std::vector<float> transmittance;             // [angle * n_wl + wl]
