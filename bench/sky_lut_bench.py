@@ -42,21 +42,20 @@ import subprocess
 import sys
 import time
 
+import yaml
+
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 
 
 def luts_section(pipeline):
-    """(method, quality, time_mapping, spectral_stride, [(sky, size, quality)]) from pipeline.yaml's luts section
-    (a sky's own quality, if it names one, else the section's)."""
-    text = open(pipeline).read()
-    sec = text[text.index("\nluts:"):]
-    sec = sec[:re.search(r"\n\S", sec[1:]).start() + 1]
-    sec = re.sub(r"#[^\n]*", "", sec)  # comments may quote a sky mapping; only the YAML counts
-    get = lambda k, d: (re.search(r"\n  %s: *([^\s#]+)" % k, sec) or [None, d])[1]
-    quality = get("quality", "medium")
-    skies = [(a, size, q or quality)
-             for a, size, q in re.findall(r"\{atmosphere: *(\w+), *size: *(\d+x\d+)(?:, *quality: *(\w+))?\}", sec)]
-    return (get("method", "orders"), quality, get("time_mapping", "gt7-quadratic"), get("spectral_stride", "1"), skies)
+    """(method, quality, time_mapping, spectral_stride, [(sky, size, quality, spectral_stride)]) from pipeline.yaml's
+    luts section (PyYAML; a sky's own quality and stride, if it names them, else the section's)."""
+    with open(pipeline) as f:
+        luts = yaml.safe_load(f)["luts"]
+    quality, stride = str(luts.get("quality", "medium")), str(luts.get("spectral_stride", 1))
+    skies = [(s["atmosphere"], s["size"], str(s.get("quality", quality)), str(s.get("spectral_stride", stride)))
+             for s in luts["skies"]]
+    return (luts.get("method", "orders"), quality, luts.get("time_mapping", "gt7-quadratic"), stride, skies)
 
 
 def timed(args, cwd):
@@ -159,11 +158,15 @@ def main():
     method, quality, time_mapping, stride, skies = luts_section(a.pipeline)
     if a.spectral_stride:
         stride = a.spectral_stride
+        skies = [(sky, size, q, a.spectral_stride) for sky, size, q, _ in skies]
     if a.size:
-        skies = [(sky, a.size, q) for sky, _, q in skies]
+        skies = [(sky, a.size, q, k) for sky, _, q, k in skies]
     if a.quality:
         quality = a.quality
-        skies = [(sky, size, a.quality) for sky, size, _ in skies]
+        skies = [(sky, size, a.quality, k) for sky, size, _, k in skies]
+    auto = [sky for sky, _, q, _ in skies if q == "auto"]
+    if auto:
+        sys.exit("sky_lut_bench: %s: quality: auto (bench/auto_quality_bench.py measures those; or --quality Q)" % ", ".join(auto))
     if a.skies:
         keep = a.skies.split(",")
         skies = [s for s in skies if s[0] in keep]
@@ -177,7 +180,7 @@ def main():
             cpu = next(l.split(":", 1)[1].strip() for l in f if l.startswith("model name"))
     except (OSError, StopIteration):
         pass
-    print("sky-render --method %s --quality %s --time-mapping %s --spectral-stride %s, %d wavelengths (%s nm), %d cpus (%s)%s"
+    print("sky-render --method %s --quality %s --time-mapping %s --spectral-stride %s (a sky's own where it names one), %d wavelengths (%s nm), %d cpus (%s)%s"
           % (method, quality, time_mapping, stride, nwl, a.wavelengths, os.cpu_count(), cpu,
              ", shortest of %d" % a.repeat if a.repeat > 1 else ""))
     refdir = os.path.abspath(a.references or os.path.join(a.work, "references"))
@@ -186,12 +189,12 @@ def main():
     for name, suns, _ in parts:
         write_geometry(os.path.join(a.work, "geometry_%s.csv" % name), suns)
     how = repr((parts, VIEWS, a.ref_max_paths, a.wavelengths))
-    print("%-8s %-7s %-7s %7s %11s %8s %21s %9s %s" % ("sky", "size", "quality", "build_s", "render_s", "peak_MiB",
+    print("%-8s %-7s %-7s %7s %11s %8s %21s %9s %s" % ("sky", "size", "q/stride", "build_s", "render_s", "peak_MiB",
                                                     "day RMS / max %", "twi RMS %", "(wall s and peak memory at threads "
                                                     + a.threads + "; errors in Y against the path references)"))
     totals = {t: 0.0 for t in threads}
     peak_all = 0.0
-    for sky, size, sky_quality in skies:
+    for sky, size, sky_quality, stride in skies:
         scene = ["--profiles", "%s/profiles.exr" % sky, "--mie-dir", "mie", "--wavelengths", a.wavelengths]
         base = [os.path.join(os.path.abspath(a.bin), "sky-render"), "--quiet", "render", "--method", method,
                 "--quality", sky_quality] + scene + ["--mapping", "gt7", "--time-mapping", time_mapping,
@@ -238,7 +241,7 @@ def main():
         else:
             err = "%21s %9s" % ("no reference", "-")
             verdict = "(--make-references)" if not os.path.exists(keyfile) else "(reference stale: --make-references)"
-        print("%-8s %-7s %-7s %7.1f %11s %8s %s %s, %s" % (sky, size, sky_quality, build, " ".join("%.1f" % w for w in walls),
+        print("%-8s %-7s %-7s %7.1f %11s %8s %s %s, %s" % (sky, size, "%s/%s" % (sky_quality, stride), build, " ".join("%.1f" % w for w in walls),
                                                     "/".join("%.0f" % m for m in peaks), err, verdict,
                                                     "same bytes" if same else "BYTES DIFFER between thread counts"))
     for t in threads:

@@ -206,6 +206,26 @@ class LutPipelineTest(PipelineTestCase):
         self.assertEqual(r.returncode, 1, r.stdout + r.stderr)
         self.assertRegex(r.stderr, r"pipeline\.yaml:17: .*quality")
 
+    def test_a_sky_may_name_its_own_spectral_stride(self):
+        # luts.skies[i].spectral_stride overrides the section's (1 here: no --spectral-stride) for that
+        # sky; with quality: auto the choice sets it, so naming one there is an error at its line.
+        self.edit("pipeline.yaml", "{atmosphere: hazed, size: 4x8}", "{atmosphere: hazed, size: 4x8, spectral_stride: 3}")
+        r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
+        with open(os.path.join(self.out, "build.ninja")) as f:
+            ninja = f.read()
+        edges = {m.group(1): m.group(2) for m in re.finditer(r"build (\w+)/lut_sky\.exr: .*\n  args = (.*)", ninja)}
+        self.assertIn("--spectral-stride 3", edges["hazed"])
+        self.assertNotIn("--spectral-stride", edges["clear"])
+        self.edit("pipeline.yaml", "spectral_stride: 3}", "spectral_stride: 2.5}")
+        r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("pipeline.yaml:17: key 'luts.skies[1].spectral_stride': expected a whole number", r.stderr)
+        self.edit("pipeline.yaml", "spectral_stride: 2.5}", "spectral_stride: 2, quality: auto}")
+        r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)
+        self.assertEqual(r.returncode, 1)
+        self.assertIn("pipeline.yaml:17: key 'luts.skies[1].spectral_stride': not with quality: auto", r.stderr)
+
     def test_quality_auto_chooses_then_renders_with_the_choice(self):
         # `quality: auto` (docs/sky-methods.md "Automatic quality"): a sky-render choose edge writes
         # hazed/lut_quality.yaml, the render edge reads it, the report carries the choice and its

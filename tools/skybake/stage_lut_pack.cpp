@@ -8,7 +8,8 @@
 //   luts:
 //     method: orders               # sky-render method of the LUT renders (docs/sky-methods.md)
 //     quality: medium              # its quality preset (a sky may name its own: below)
-//     spectral_stride: 2           # the method on every 2nd wavelength, transfer interpolated (1 = all)
+//     spectral_stride: 2           # the method on every 2nd wavelength, transfer interpolated (1 = all;
+//                                  # a sky may name its own)
 //     time_mapping: gt7-quadratic  # or gt7 (the talk's; docs/lut-pack.md), optionally ":<upper>+<lower>"
 //     sky_exposure_stops: auto     # or N: sky texels store cd/m^2 x 2^N (auto: per texture, no clamping)
 //     budget_mib: 3.5              # lut-pack fails when the sky LUTs exceed it
@@ -58,10 +59,21 @@ struct LutSky {
   std::string atmosphere;
   std::string size;
   Quality quality = Quality::kMedium;  // the section's unless the sky names its own
+  int spectral_stride = 1;             // the section's unless the sky names its own
   int shards = 1;                      // the section's unless the sky names its own
   FileLoc loc;
-  AutoQuality auto_quality;           // the section's unless the sky names its own
+  AutoQuality auto_quality;            // the section's unless the sky names its own
 };
+
+// The key `spectral_stride` of `map` (a whole number 1-64), `fallback` when absent.
+int SpectralStrideOr(YamlMap& map, int fallback) {
+  const double stride = map.NumberOr("spectral_stride", NumberSpec::Range(1, 64, "wavelengths"), fallback);
+  if (stride != std::floor(stride)) {
+    map.Get("spectral_stride")->ErrorExpected("a whole number of wavelengths from 1 to 64");
+    return fallback;
+  }
+  return static_cast<int>(stride);
+}
 
 // Reads `quality` (low, medium, high or auto) and the tolerance keys of `map` over what the
 // section (or the defaults) gave.
@@ -105,12 +117,7 @@ class LutPackStage : public Stage {
     enabled_ = true;
     method_ = luts->ChoiceOr("method", SkyMethodNames(), method_);
     ReadQuality(*luts, &quality_, &auto_);
-    const double stride = luts->NumberOr("spectral_stride", NumberSpec::Range(1, 64, "wavelengths"), spectral_stride_);
-    if (stride != std::floor(stride)) {
-      luts->Get("spectral_stride")->ErrorExpected("a whole number of wavelengths from 1 to 64");
-    } else {
-      spectral_stride_ = static_cast<int>(stride);
-    }
+    spectral_stride_ = SpectralStrideOr(*luts, spectral_stride_);
     time_mapping_ = TimeMappingOr(*luts, time_mapping_);
     if (std::optional<YamlNode> e = luts->Get("sky_exposure_stops")) {
       const std::optional<std::string> text = e->ToString("auto or a whole number of stops from -24 to 24");
@@ -127,7 +134,8 @@ class LutPackStage : public Stage {
     shards_ = ShardsOr(*luts, shards_);
     std::set<std::string> seen;
     for (const YamlNode& n : luts->Seq("skies")) {
-      YamlMap m = n.ToMap("a mapping {atmosphere: NAME, size: WxH[, quality: " + TextList(QualityNames(), "|", "|") + "|auto]}");
+      YamlMap m = n.ToMap("a mapping {atmosphere: NAME, size: WxH[, quality: " + TextList(QualityNames(), "|", "|") +
+                          "|auto][, spectral_stride: K]}");
       if (!m.valid()) continue;
       LutSky s;
       s.loc = n.loc();
@@ -138,6 +146,10 @@ class LutPackStage : public Stage {
       s.quality = quality_;
       s.auto_quality = auto_;
       ReadQuality(m, &s.quality, &s.auto_quality);
+      s.spectral_stride = SpectralStrideOr(m, spectral_stride_);
+      if (s.auto_quality.enabled && m.Has("spectral_stride")) {
+        m.Get("spectral_stride")->Error("not with quality: auto (the choice sets the stride)");
+      }
       s.shards = ShardsOr(m, shards_);
       if (s.shards > TimeMappingSlices(time_mapping_)) {
         (m.Has("shards") ? *m.Get("shards") : n)
@@ -204,7 +216,7 @@ class LutPackStage : public Stage {
         args = fmt::format("render --settings {} {}", c.outputs[0], scene);
       } else {
         args = fmt::format("render --method {} --quality {} {}", method_, QualityName(s.quality), scene);
-        if (spectral_stride_ > 1) args += fmt::format(" --spectral-stride {}", spectral_stride_);
+        if (s.spectral_stride > 1) args += fmt::format(" --spectral-stride {}", s.spectral_stride);
       }
       args += fmt::format(" --mapping gt7 --size {} --time-mapping {}", s.size, time_mapping_);
       b.variables = {{"args", args}};
