@@ -13,9 +13,9 @@
 // The candidates are tried in the order of a fixed cost model (CandidateCost below: the preset's
 // measured relative build cost x the wavelengths it runs on), not of measured times, so that the
 // choice is the same bytes on every machine and at any thread count; the first within is chosen.
-// A candidate coarser than a rejected one in both preset and stride is rejected without being
-// built (the error does not fall when both are coarsened); the full model is the fallback and has
-// no error by definition.
+// A candidate no finer than a rejected one in both preset and stride is rejected without being
+// built (kDominated: the error does not fall when both are coarsened); the full model is the
+// fallback and has no error by definition.
 #pragma once
 
 #include <filesystem>
