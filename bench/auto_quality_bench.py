@@ -26,19 +26,12 @@ import os
 import re
 import subprocess
 import sys
-import time
+
+import yaml
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), ".."))
 sys.path.insert(0, os.path.dirname(__file__))
-from sky_lut_bench import luts_section  # noqa: E402
-
-
-def timed(args, cwd):
-    t0 = time.perf_counter()
-    p = subprocess.run(args, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    if p.returncode != 0:
-        sys.exit("failed: %s\n%s" % (" ".join(args), p.stderr))
-    return time.perf_counter() - t0, p.stdout
+from sky_lut_bench import luts_section, timed  # noqa: E402
 
 
 def slices_y(path):
@@ -102,11 +95,12 @@ def main():
         t_choose, _ = timed([sr, "choose"] + scene + ["--method", method, "--tolerance", a.tolerance, "--max-tolerance",
                                                       a.max_tolerance, "--twilight-tolerance", a.twilight_tolerance, "-o", choice],
                             a.outputs)
-        chosen = dict(re.findall(r"^(quality|spectral_stride): (\w+)$", open(choice).read(), re.M))
+        with open(choice) as f:
+            chosen = yaml.safe_load(f)
         t_auto, _ = timed([sr, "render"] + scene + lut + ["--settings", choice, "-o", os.path.join(w, "auto.exr")], a.outputs)
         if quality == "auto":  # the pipeline has no settings by hand for this sky: compare auto with itself
             quality = chosen["quality"]
-            stride_hand = chosen["spectral_stride"]
+            stride_hand = str(chosen["spectral_stride"])
         else:
             stride_hand = stride
         t_hand, _ = timed([sr, "render"] + scene + lut + ["--method", method, "--quality", quality, "--spectral-stride", stride_hand,

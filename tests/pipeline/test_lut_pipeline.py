@@ -57,6 +57,11 @@ def edges_run(ninja_stdout):
     return [m.group(1) for m in re.finditer(r"^\[\d+/\d+\] (.*)$", ninja_stdout, re.M)]
 
 
+def lut_render_args(ninja):
+    """{sky: the args of its outputs/<sky>/lut_sky.exr edge} of a build.ninja."""
+    return {m.group(1): m.group(2) for m in re.finditer(r"build (\w+)/lut_sky\.exr: .*\n  args = (.*)", ninja)}
+
+
 def ktx2_texels(path):
     """(width, height, depth, layers, level bytes) of a KTX2 file, read with struct (ktxspec
     'File Structure': 12-byte identifier, 9 UInt32 header fields, index, level index at byte 80)."""
@@ -148,6 +153,10 @@ class LutPipelineTest(PipelineTestCase):
                 f.write(text)
         self.out = self.path("outputs")
 
+    def read_ninja(self):
+        with open(os.path.join(self.out, "build.ninja")) as f:
+            return f.read()
+
     def test_fresh_bake_then_no_work_and_an_edit_reruns_only_its_sky(self):
         r = self.bake()
         ran = edges_run(r.stdout)
@@ -194,9 +203,8 @@ class LutPipelineTest(PipelineTestCase):
         self.edit("pipeline.yaml", "{atmosphere: hazed, size: 4x8}", "{atmosphere: hazed, size: 4x8, quality: high}")
         r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)
         self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
-        with open(os.path.join(self.out, "build.ninja")) as f:
-            ninja = f.read()
-        edges = {m.group(1): m.group(2) for m in re.finditer(r"build (\w+)/lut_sky\.exr: .*\n  args = (.*)", ninja)}
+        ninja = self.read_ninja()
+        edges = lut_render_args(ninja)
         self.assertEqual(sorted(edges), ["clear", "cloudy2", "hazed"], ninja)
         self.assertIn("--quality high", edges["hazed"])
         self.assertIn("--quality low", edges["clear"])
@@ -212,9 +220,8 @@ class LutPipelineTest(PipelineTestCase):
         self.edit("pipeline.yaml", "{atmosphere: hazed, size: 4x8}", "{atmosphere: hazed, size: 4x8, spectral_stride: 3}")
         r = run([tool("skybake"), "generate", "pipeline.yaml"], cwd=self.tmp)
         self.assertEqual(r.returncode, 0, r.stdout + r.stderr)
-        with open(os.path.join(self.out, "build.ninja")) as f:
-            ninja = f.read()
-        edges = {m.group(1): m.group(2) for m in re.finditer(r"build (\w+)/lut_sky\.exr: .*\n  args = (.*)", ninja)}
+        ninja = self.read_ninja()
+        edges = lut_render_args(ninja)
         self.assertIn("--spectral-stride 3", edges["hazed"])
         self.assertNotIn("--spectral-stride", edges["clear"])
         self.edit("pipeline.yaml", "spectral_stride: 3}", "spectral_stride: 2.5}")
@@ -235,9 +242,8 @@ class LutPipelineTest(PipelineTestCase):
         ran = edges_run(r.stdout)
         self.assertIn("sky-render hazed/lut_quality.yaml", ran)
         self.assertNotIn("sky-render clear/lut_quality.yaml", ran)
-        with open(os.path.join(self.out, "build.ninja")) as f:
-            ninja = f.read()
-        edges = {m.group(1): m.group(2) for m in re.finditer(r"build (\w+)/lut_sky\.exr: .*\n  args = (.*)", ninja)}
+        ninja = self.read_ninja()
+        edges = lut_render_args(ninja)
         self.assertIn("--settings hazed/lut_quality.yaml", edges["hazed"])
         self.assertNotIn("--quality", edges["hazed"])
         self.assertIn("--quality low", edges["clear"])

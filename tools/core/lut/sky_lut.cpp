@@ -29,7 +29,6 @@ std::string Join(const std::vector<double>& v) {
   return s;
 }
 
-// The `method: ...` line of the render's resolved parameters (provenance), for the report.
 // The value of the first provenance line "<key>: value" of the render's parameters ("" if none).
 std::string ParameterOf(const ExrImage& img, const std::string& key) {
   const std::string* p = FindStringAttribute(img, "skybake.parameters");

@@ -1,9 +1,6 @@
 #include "transport/auto_quality.h"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -14,6 +11,7 @@
 #include "io/error.h"
 #include "io/text_list.h"
 #include "io/yaml.h"
+#include "transport/budget.h"
 #include "transport/sky_error.h"
 #include "transport/sky_method.h"
 #include "transport/spectral_stride.h"
@@ -23,7 +21,7 @@ namespace skybake {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
-using Sky = std::vector<std::array<double, 3>>;  // observer XYZ per direction
+using Sky = ChartSky;  // observer XYZ per direction
 
 // The build + render time of `orders` per preset relative to `high`, at one stride (the time is
 // linear in the wavelength count, transport/spectral_stride.h). Measured with `sky-render choose`
@@ -34,7 +32,6 @@ constexpr std::array<double, kQualityCount> kPresetCost = {0.035, 0.19, 1.0};
 const char* StatusName(AutoQualityCandidate::Status s) {
   switch (s) {
     case AutoQualityCandidate::Status::kChosen: return "chosen";
-    case AutoQualityCandidate::Status::kWithin: return "within";
     case AutoQualityCandidate::Status::kRejected: return "rejected";
     case AutoQualityCandidate::Status::kDominated: return "dominated";
     case AutoQualityCandidate::Status::kNotTried: return "not-tried";
@@ -42,22 +39,18 @@ const char* StatusName(AutoQualityCandidate::Status s) {
   return "?";
 }
 
-// The method's skies at every sun angle; returns the seconds it took (build + render).
+// The method's skies at every sun angle at the observer's altitude (RenderChartSkies, budget.h);
+// returns the build + render seconds.
 double RenderSkies(const Scene& sc, const std::string& name, Quality q, int stride, const SkyDirections& D,
                    const std::vector<double>& sun_zenith_deg, std::vector<Sky>* out) {
-  const auto t0 = std::chrono::steady_clock::now();
   SkyMethodOptions mo;
   mo.quality = q;
   mo.spectral_stride = stride;
   mo.observer_altitude_m = sc.spec.observer_altitude_m;
-  std::unique_ptr<SkyMethod> method = MakeSkyMethod(name, sc.model, mo, {});
-  out->assign(sun_zenith_deg.size(), {});
-  tbb::parallel_for(size_t{0}, sun_zenith_deg.size(), size_t{1}, [&](size_t s) {
-    std::vector<double> L;
-    method->Radiance(sc.spec.observer_altitude_m, sun_zenith_deg[s] * kDeg, D.dirs, &L);
-    (*out)[s] = SpectralToXyz(L, sc.xyz_weights);
-  });
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::vector<std::vector<ChartSky>> skies;
+  const double seconds = RenderChartSkies(sc, name, mo, {sc.spec.observer_altitude_m}, sun_zenith_deg, D, &skies);
+  *out = std::move(skies[0]);
+  return seconds;
 }
 
 std::string Percent(double v) { return fmt::format("{:.4g} %", 100.0 * v); }
@@ -158,7 +151,6 @@ AutoQualityChoice ChooseQuality(const SceneOptions& so, const AutoQualityOptions
                    static_cast<double>(k + 1) / steps);
     std::vector<Sky> test;
     c.seconds = RenderSkies(sc, o.method, c.quality, c.stride, D, suns, &test);
-    c.evaluated = true;
     for (size_t s = 0; s < suns.size(); ++s) {
       const SkyCompareInput in{&D, suns[s] * kDeg, 1.0, &full[s], nullptr, &test[s], &to2020, &toref};
       const SkyError e = CompareSkies(in);
@@ -181,12 +173,9 @@ AutoQualityChoice ChooseQuality(const SceneOptions& so, const AutoQualityOptions
     c.wavelengths = sc.grid.size();
     c.cost = CandidateCost(full_q, c.wavelengths, sc.grid.size());
     c.status = AutoQualityCandidate::Status::kChosen;
-    c.evaluated = true;
     c.seconds = ch.full_seconds;
     ch.candidates.push_back(c);
   }
-  ch.quality = ch.chosen().quality;
-  ch.stride = ch.chosen().stride;
   ReportProgress(progress, "choose", 1.0);
   return ch;
 }
@@ -203,7 +192,7 @@ std::string AutoQualityYaml(const AutoQualityChoice& ch) {
       "# sky-render choose: the cheapest settings of the method whose sky stays within the tolerances of its full\n"
       "# model (docs/sky-methods.md \"Automatic quality\"); errors are relative luminance outside a 1 deg aureole on\n"
       "# the 91 directions of the sky chart, the worst over the sun angles.\n";
-  out += fmt::format("method: {}\nquality: {}\nspectral_stride: {}\n", ch.method, QualityName(ch.quality), ch.stride);
+  out += fmt::format("method: {}\nquality: {}\nspectral_stride: {}\n", ch.method, QualityName(c.quality), c.stride);
   out += fmt::format("full_model: {{quality: high, spectral_stride: 1, wavelengths: {}}}\n", ch.grid_wavelengths);
   out += fmt::format("tolerance: {{daylight_rms: {}, daylight_max: {}, twilight_rms: {}}}\n", FormatExact(o.tolerance_rms),
                      FormatExact(o.tolerance_max), FormatExact(o.twilight_tolerance_rms));
@@ -217,7 +206,7 @@ std::string AutoQualityYaml(const AutoQualityChoice& ch) {
   out += "candidates:  # in the order tried (a fixed cost model, relative to the full model)\n";
   for (const AutoQualityCandidate& k : ch.candidates) {
     out += fmt::format("  - {{quality: {}, spectral_stride: {}, wavelengths: {}, cost: {:.4g}, status: {}{}}}\n", QualityName(k.quality),
-                       k.stride, k.wavelengths, k.cost, StatusName(k.status), k.evaluated ? ", " + errors(k) : "");
+                       k.stride, k.wavelengths, k.cost, StatusName(k.status), k.evaluated() ? ", " + errors(k) : "");
   }
   return out;
 }
@@ -227,12 +216,12 @@ std::string AutoQualityTable(const AutoQualityChoice& ch) {
   std::string out = fmt::format(
       "{}: chosen {} at spectral stride {} (tolerances: daylight RMS {}, max {}; twilight RMS {}); full model (high, stride 1, {} "
       "wavelengths): {:.2f} s\n",
-      ch.method, QualityName(ch.quality), ch.stride, Percent(o.tolerance_rms), Percent(o.tolerance_max),
+      ch.method, QualityName(ch.chosen().quality), ch.chosen().stride, Percent(o.tolerance_rms), Percent(o.tolerance_max),
       Percent(o.twilight_tolerance_rms), ch.grid_wavelengths, ch.full_seconds);
   out += fmt::format("{:<8} {:>6} {:>4} {:>7} {:>10} {:>10} {:>10} {:>8}  {}\n", "quality", "stride", "wl", "cost", "day rms %",
                      "day max %", "twi rms %", "seconds", "status");
   for (const AutoQualityCandidate& k : ch.candidates) {
-    const auto pct = [&](double v) { return k.evaluated ? fmt::format("{:.3f}", 100.0 * v) : std::string("-"); };
+    const auto pct = [&](double v) { return k.evaluated() ? fmt::format("{:.3f}", 100.0 * v) : std::string("-"); };
     out += fmt::format("{:<8} {:>6} {:>4} {:>7.3f} {:>10} {:>10} {:>10} {:>8}  {}\n", QualityName(k.quality), k.stride, k.wavelengths,
                        k.cost, pct(k.daylight_rms), pct(k.daylight_max), pct(k.twilight_rms),
                        k.seconds > 0 ? fmt::format("{:.2f}", k.seconds) : "-", StatusName(k.status));

@@ -43,22 +43,21 @@ struct AutoQualityCandidate {
   int stride = 1;
   size_t wavelengths = 0;       // the method runs on (transport/spectral_stride.h)
   double cost = 0.0;            // CandidateCost, relative to the full model
-  enum class Status { kChosen, kWithin, kRejected, kDominated, kNotTried } status = Status::kNotTried;
-  bool evaluated = false;       // built and compared (kChosen/kWithin/kRejected)
+  enum class Status { kChosen, kRejected, kDominated, kNotTried } status = Status::kNotTried;
   double daylight_rms = 0.0, daylight_max = 0.0, twilight_rms = 0.0;  // relative, worst over the sun angles
   double seconds = 0.0;         // measured build + render (not written to the settings file)
+  // Built and compared with the full model (the errors above are measured).
+  bool evaluated() const { return status == Status::kChosen || status == Status::kRejected; }
 };
 
 struct AutoQualityChoice {
   std::string method;
-  Quality quality = Quality::kHigh;
-  int stride = 1;
   AutoQualityOptions options;
   size_t grid_wavelengths = 0;
   std::vector<AutoQualityCandidate> candidates;  // in cost order; exactly one kChosen
   double full_seconds = 0.0;                      // the full model's build + render (measured)
   std::vector<std::filesystem::path> files_read;  // of the scene (for depfiles)
-  const AutoQualityCandidate& chosen() const;
+  const AutoQualityCandidate& chosen() const;  // its quality and stride are the choice
 };
 
 // The fixed cost model: preset build cost (relative to the highest preset, measured once and

@@ -20,7 +20,7 @@ namespace skybake {
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180.0;
-using Sky = std::vector<std::array<double, 3>>;  // observer XYZ per direction
+using Sky = ChartSky;  // observer XYZ per direction
 
 struct Evaluator {
   const BudgetOptions& o;
@@ -28,25 +28,31 @@ struct Evaluator {
   // Skies at every sun angle for a scene, an orders cap and an observer altitude; returns seconds.
   double Render(const Scene& sc, int orders, const std::vector<double>& altitudes, std::vector<std::vector<Sky>>* out,
                 std::string* description = nullptr) const {
-    const auto t0 = std::chrono::steady_clock::now();
     SkyMethodOptions mo;
     mo.quality = o.quality;
     mo.orders = orders;
-    std::unique_ptr<SkyMethod> method = MakeSkyMethod(o.method, sc.model, mo, {});
-    if (description) *description = method->Describe();
-    out->assign(altitudes.size(), std::vector<Sky>(o.sun_zenith_deg.size()));
-    const size_t n = altitudes.size() * o.sun_zenith_deg.size();
-    tbb::parallel_for(size_t{0}, n, size_t{1}, [&](size_t k) {
-      const size_t a = k / o.sun_zenith_deg.size(), s = k % o.sun_zenith_deg.size();
-      std::vector<double> L;
-      method->Radiance(altitudes[a], o.sun_zenith_deg[s] * kDeg, D.dirs, &L);
-      (*out)[a][s] = SpectralToXyz(L, sc.xyz_weights);
-    });
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return RenderChartSkies(sc, o.method, mo, altitudes, o.sun_zenith_deg, D, out, description);
   }
 };
 
 }  // namespace
+
+double RenderChartSkies(const Scene& sc, const std::string& name, const SkyMethodOptions& options,
+                        const std::vector<double>& altitudes, const std::vector<double>& sun_zenith_deg, const SkyDirections& D,
+                        std::vector<std::vector<ChartSky>>* out, std::string* description) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::unique_ptr<SkyMethod> method = MakeSkyMethod(name, sc.model, options, {});
+  if (description) *description = method->Describe();
+  out->assign(altitudes.size(), std::vector<ChartSky>(sun_zenith_deg.size()));
+  const size_t n = altitudes.size() * sun_zenith_deg.size();
+  tbb::parallel_for(size_t{0}, n, size_t{1}, [&](size_t k) {
+    const size_t a = k / sun_zenith_deg.size(), s = k % sun_zenith_deg.size();
+    std::vector<double> L;
+    method->Radiance(altitudes[a], sun_zenith_deg[s] * kDeg, D.dirs, &L);
+    (*out)[a][s] = SpectralToXyz(L, sc.xyz_weights);
+  });
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
 
 double ParseTolerance(const std::string& text, const std::string& option) {
   std::string t;

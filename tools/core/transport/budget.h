@@ -65,6 +65,15 @@ struct BudgetReport {
   std::vector<std::filesystem::path> files_read;  // of the baseline scene (for depfiles)
 };
 
+// The skies of a deterministic method, built once from `options`, on the directions D at every
+// altitude x sun zenith: observer XYZ per direction, (*out)[altitude][sun]. Returns the build +
+// render seconds; `description` gets the method's Describe(). The budget's and the automatic
+// quality's evaluator (transport/auto_quality.h).
+using ChartSky = std::vector<std::array<double, 3>>;
+double RenderChartSkies(const Scene& scene, const std::string& method, const SkyMethodOptions& options,
+                        const std::vector<double>& altitudes_m, const std::vector<double>& sun_zenith_deg, const SkyDirections& D,
+                        std::vector<std::vector<ChartSky>>* out, std::string* description = nullptr);
+
 // Throws UsageError for bad options (unknown method/criterion, tolerance <= 0, an empty or
 // out-of-range altitude range) and what LoadScene throws.
 BudgetReport RunBudget(const SceneOptions& scene, const BudgetOptions& options, const ProgressFn& progress);
