@@ -18,6 +18,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "optics/mie_sphere.h"
 
@@ -389,4 +390,25 @@ TEST(MieSphere, WiscombeTermCount) {
   EXPECT_EQ(WiscombeTerms(100.0), 120);
   EXPECT_EQ(WiscombeTerms(10000.0), 10088);
   EXPECT_EQ(WiscombeTerms(1e-6), 2);  // floor: g of a Rayleigh sphere needs a_2 and b_1
+}
+
+// Spheres computed together (their D_n recurrences interleaved) get the same bits as one at a
+// time: sizes from 0.1 to 800 with different term counts, absorbing and not, in one batch.
+TEST(MieSphere, BatchGivesTheSameBitsAsOneAtATime) {
+  const std::vector<double> xs{0.1, 3.0, 47.5, 800.0, 12.0, 230.0, 1.0, 500.0};
+  for (Complex m : {Complex(1.33, 1e-8), Complex(1.75, 0.44)}) {
+    std::vector<MieCoefficients> batch(xs.size());
+    MieWorkspace ws;
+    ComputeCoefficients(xs, m, batch, ws);
+    for (size_t i = 0; i < xs.size(); ++i) {
+      MieCoefficients one;
+      MieWorkspace ws1;
+      ComputeCoefficients(xs[i], m, one, ws1);
+      ASSERT_EQ(one.terms, batch[i].terms);
+      for (int n = 0; n < one.terms; ++n) {
+        ASSERT_EQ(one.a[n], batch[i].a[n]) << "x = " << xs[i] << ", n = " << n + 1;
+        ASSERT_EQ(one.b[n], batch[i].b[n]) << "x = " << xs[i] << ", n = " << n + 1;
+      }
+    }
+  }
 }

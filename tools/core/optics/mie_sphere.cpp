@@ -1,5 +1,6 @@
 #include "optics/mie_sphere.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -67,27 +68,15 @@ Complex LogDerivativeLentz(int n, Complex z, int* iterations) {
 }
 
 void ComputeCoefficients(double x, Complex m, MieCoefficients& out, MieWorkspace& ws) {
-  SKYBAKE_CHECK(std::isfinite(x) && x > 0.0);
-  SKYBAKE_CHECK(std::isfinite(m.real()) && std::isfinite(m.imag()) && m.real() > 0.0 && m.imag() >= 0.0);
-  const int N = WiscombeTerms(x);
-  out.x = x;
-  out.m = m;
-  out.terms = N;
-  out.a.resize(N);
-  out.b.resize(N);
+  ComputeCoefficients(std::span<const double>(&x, 1), m, std::span<MieCoefficients>(&out, 1), ws);
+}
 
-  // D_n(mx), n = N .. 0, downward from the continued-fraction value at N (BH eq. 4.89).
-  const Complex z = m * x;
-  const Complex inv_z = 1.0 / z;
-  ws.d_mx.resize(N + 1);
-  ws.d_mx[N] = -static_cast<double>(N) * inv_z + BesselRatio<Complex>(N + 0.5, z, &out.lentz_iterations);
-  for (int n = N; n >= 1; --n) {
-    const Complex nz = static_cast<double>(n) * inv_z;
-    Complex den = ws.d_mx[n] + nz;
-    if (Magnitude(den) < kTiny) den = Complex(kTiny);
-    ws.d_mx[n - 1] = nz - 1.0 / den;
-  }
+namespace {
 
+// a_n, b_n of one sphere from its D_n(mx), with psi_n(x) and chi_n(x).
+void CoefficientsFromLogDerivative(double x, Complex m, const std::vector<Complex>& d_mx, MieCoefficients& out,
+                                   MieWorkspace& ws) {
+  const int N = out.terms;
   // psi_n(x): upward while n <= x, then by ratios from D_n(x) (see the header).
   const double inv_x = 1.0 / x;
   const double sin_x = std::sin(x), cos_x = std::cos(x);
@@ -124,11 +113,51 @@ void ComputeCoefficients(double x, Complex m, MieCoefficients& out, MieWorkspace
     const double nx = n * inv_x;
     const Complex xi_n(ws.psi[n], -ws.chi[n]);
     const Complex xi_nm1(ws.psi[n - 1], -ws.chi[n - 1]);
-    const Complex da = ws.d_mx[n] * inv_m + nx;
-    const Complex db = m * ws.d_mx[n] + nx;
+    const Complex da = d_mx[n] * inv_m + nx;
+    const Complex db = m * d_mx[n] + nx;
     out.a[n - 1] = (da * ws.psi[n] - ws.psi[n - 1]) / (da * xi_n - xi_nm1);
     out.b[n - 1] = (db * ws.psi[n] - ws.psi[n - 1]) / (db * xi_n - xi_nm1);
   }
+}
+
+}  // namespace
+
+void ComputeCoefficients(std::span<const double> xs, Complex m, std::span<MieCoefficients> outs, MieWorkspace& ws) {
+  SKYBAKE_CHECK_EQ(xs.size(), outs.size());
+  SKYBAKE_CHECK(std::isfinite(m.real()) && std::isfinite(m.imag()) && m.real() > 0.0 && m.imag() >= 0.0);
+  const size_t count = xs.size();
+  if (ws.d_mx.size() < count) ws.d_mx.resize(count);
+  ws.inv_mx.resize(count);
+  int n_max = 0;
+  for (size_t i = 0; i < count; ++i) {
+    const double x = xs[i];
+    SKYBAKE_CHECK(std::isfinite(x) && x > 0.0);
+    MieCoefficients& out = outs[i];
+    const int N = WiscombeTerms(x);
+    out.x = x;
+    out.m = m;
+    out.terms = N;
+    out.a.resize(N);
+    out.b.resize(N);
+    // D_n(mx), n = N .. 0, downward from the continued-fraction value at N (BH eq. 4.89).
+    const Complex z = m * x;
+    ws.inv_mx[i] = 1.0 / z;
+    std::vector<Complex>& d = ws.d_mx[i];
+    d.resize(N + 1);
+    d[N] = -static_cast<double>(N) * ws.inv_mx[i] + BesselRatio<Complex>(N + 0.5, z, &out.lentz_iterations);
+    n_max = std::max(n_max, N);
+  }
+  for (int n = n_max; n >= 1; --n) {
+    for (size_t i = 0; i < count; ++i) {
+      if (n > outs[i].terms) continue;
+      std::vector<Complex>& d = ws.d_mx[i];
+      const Complex nz = static_cast<double>(n) * ws.inv_mx[i];
+      Complex den = d[n] + nz;
+      if (Magnitude(den) < kTiny) den = Complex(kTiny);
+      d[n - 1] = nz - 1.0 / den;
+    }
+  }
+  for (size_t i = 0; i < count; ++i) CoefficientsFromLogDerivative(xs[i], m, ws.d_mx[i], outs[i], ws);
 }
 
 MieEfficiencies Efficiencies(const MieCoefficients& c) {

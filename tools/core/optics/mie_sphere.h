@@ -64,7 +64,8 @@ Complex LogDerivativeLentz(int n, Complex z, int* iterations = nullptr);
 
 // Reusable buffers so that repeated calls (one per radius in a size integral) do not allocate.
 struct MieWorkspace {
-  std::vector<Complex> d_mx;   // D_n(mx), n = 0..N
+  std::vector<std::vector<Complex>> d_mx;  // per sphere of a batch: D_n(mx), n = 0..N
+  std::vector<Complex> inv_mx;             // per sphere of a batch: 1 / (m x)
   std::vector<double> d_x;     // D_n(x) where the ratio method is used
   std::vector<double> psi;     // psi_n(x), n = 0..N (index n)
   std::vector<double> chi;     // chi_n(x), n = 0..N
@@ -81,6 +82,10 @@ struct MieCoefficients {
 
 // Computes a_n, b_n for x > 0 and m with Re m > 0, Im m >= 0 (checked).
 void ComputeCoefficients(double x, Complex m, MieCoefficients& out, MieWorkspace& ws);
+// The same for several spheres of one index (out[i] for x[i]; the same bits as one at a time).
+// The downward D_n(mx) recurrence is a chain of dependent complex divisions (~10 ns per term,
+// most of a sphere's cost); the spheres' chains are interleaved so that their latencies overlap.
+void ComputeCoefficients(std::span<const double> x, Complex m, std::span<MieCoefficients> out, MieWorkspace& ws);
 
 // Efficiencies from coefficients (the sums above).
 struct MieEfficiencies {
