@@ -194,6 +194,78 @@ void GramUpdateBaseline(double* ga, double* gb, size_t stride, size_t terms, con
   GramUpdateTiles4(ga, gb, stride, terms, buf, wbuf, count);
 }
 
+// The direct sums: per angle of the tiles, plus = |U(+mu)|^2 + |V(+mu)|^2 and minus = |U(-mu)|^2
+// + |V(-mu)|^2 with U(+mu) = sum alpha p, U(-mu) = sum alpha q~, V(+mu) = sum beta q, V(-mu) =
+// sum beta p~ (coef: Re alpha, Im alpha, Re beta, Im beta per term). One tile of 8 angles per pass
+// over the terms in 8 lanes (AVX-512), half a tile in 4 lanes (AVX2, baseline): a lane's
+// operations are the same in both.
+__attribute__((target("avx512f"))) void DirectSumsAvx512(const double* coef, size_t n, const double* tables,
+                                                         size_t tiles, size_t tile_stride, double* plus, double* minus) {
+  constexpr size_t T = AngularTables::kTile;
+  constexpr size_t R = AngularTables::kRow;
+  for (size_t k = 0; k < tiles; ++k) {
+    V8 u0 = Splat8(0.0), u1 = u0, um0 = u0, um1 = u0, v0 = u0, v1 = u0, vm0 = u0, vm1 = u0;
+    const double* tile = tables + k * tile_stride;
+    for (size_t j = 0; j < n; ++j) {
+      const double* t = tile + j * R;
+      const V8 ar = Splat8(coef[4 * j]), ai = Splat8(coef[4 * j + 1]);
+      const V8 br = Splat8(coef[4 * j + 2]), bi = Splat8(coef[4 * j + 3]);
+      const V8 p = Load8(t), qt = Load8(t + T), q = Load8(t + 2 * T), pt = Load8(t + 3 * T);
+      u0 += ar * p;
+      u1 += ai * p;
+      um0 += ar * qt;
+      um1 += ai * qt;
+      v0 += br * q;
+      v1 += bi * q;
+      vm0 += br * pt;
+      vm1 += bi * pt;
+    }
+    const V8 pl = ((u0 * u0 + u1 * u1) + v0 * v0) + v1 * v1;
+    const V8 mi = ((um0 * um0 + um1 * um1) + vm0 * vm0) + vm1 * vm1;
+    __builtin_memcpy(plus + k * T, &pl, sizeof(pl));
+    __builtin_memcpy(minus + k * T, &mi, sizeof(mi));
+  }
+}
+
+__attribute__((always_inline)) inline void DirectSumsLanes4(const double* coef, size_t n, const double* tables,
+                                                            size_t tiles, size_t tile_stride, double* plus,
+                                                            double* minus) {
+  constexpr size_t T = AngularTables::kTile;
+  constexpr size_t R = AngularTables::kRow;
+  const V4 zero = {0.0, 0.0, 0.0, 0.0};
+  for (size_t k = 0; k < tiles; ++k) {
+    for (size_t h = 0; h < T; h += 4) {
+      V4 u0 = zero, u1 = zero, um0 = zero, um1 = zero, v0 = zero, v1 = zero, vm0 = zero, vm1 = zero;
+      const double* tile = tables + k * tile_stride + h;
+      for (size_t j = 0; j < n; ++j) {
+        const double* t = tile + j * R;
+        const double ar = coef[4 * j], ai = coef[4 * j + 1], br = coef[4 * j + 2], bi = coef[4 * j + 3];
+        const V4 p = Load4(t), qt = Load4(t + T), q = Load4(t + 2 * T), pt = Load4(t + 3 * T);
+        u0 += ar * p;
+        u1 += ai * p;
+        um0 += ar * qt;
+        um1 += ai * qt;
+        v0 += br * q;
+        v1 += bi * q;
+        vm0 += br * pt;
+        vm1 += bi * pt;
+      }
+      const V4 pl = ((u0 * u0 + u1 * u1) + v0 * v0) + v1 * v1;
+      const V4 mi = ((um0 * um0 + um1 * um1) + vm0 * vm0) + vm1 * vm1;
+      __builtin_memcpy(plus + k * T + h, &pl, sizeof(pl));
+      __builtin_memcpy(minus + k * T + h, &mi, sizeof(mi));
+    }
+  }
+}
+__attribute__((target("avx2"))) void DirectSumsAvx2(const double* coef, size_t n, const double* tables, size_t tiles,
+                                                    size_t tile_stride, double* plus, double* minus) {
+  DirectSumsLanes4(coef, n, tables, tiles, tile_stride, plus, minus);
+}
+void DirectSumsBaseline(const double* coef, size_t n, const double* tables, size_t tiles, size_t tile_stride,
+                        double* plus, double* minus) {
+  DirectSumsLanes4(coef, n, tables, tiles, tile_stride, plus, minus);
+}
+
 // The kernels' instruction set on this CPU, read once: 2 AVX-512, 1 AVX2, 0 baseline x86-64.
 int KernelLevel() {
   static const int level = __builtin_cpu_supports("avx512f") ? 2 : __builtin_cpu_supports("avx2") ? 1 : 0;
@@ -371,6 +443,14 @@ void GramEvaluateBaseline(const double* ga, const double* gb, size_t stride, siz
   GramEvaluateLanes4(ga, gb, stride, terms, tables, tiles, tile_stride, half, out);
 }
 
+void DirectSums(const double* coef, size_t n, const double* tables, size_t tiles, size_t tile_stride, double* plus,
+                double* minus) {
+  const int isa = KernelLevel();
+  if (isa == 2) DirectSumsAvx512(coef, n, tables, tiles, tile_stride, plus, minus);
+  else if (isa == 1) DirectSumsAvx2(coef, n, tables, tiles, tile_stride, plus, minus);
+  else DirectSumsBaseline(coef, n, tables, tiles, tile_stride, plus, minus);
+}
+
 void GramEvaluate(const double* ga, const double* gb, size_t stride, size_t terms, const double* tables, size_t tiles,
                   size_t tile_stride, size_t half, double* out) {
   const int isa = KernelLevel();
@@ -382,15 +462,48 @@ void GramEvaluate(const double* ga, const double* gb, size_t stride, size_t term
 
 }  // namespace detail
 
-IntensityAccumulator::IntensityAccumulator(int max_terms)
-    : n_(max_terms),
-      stride_((static_cast<size_t>(max_terms) + 15) / 16 * 16),
-      ga_(stride_ * stride_, 0.0),
-      gb_(stride_ * stride_, 0.0),
-      buf_(kBatch * 4 * stride_, 0.0),
-      wbuf_(kBatch * 4 * stride_, 0.0),
-      slot_len_(kBatch, 0) {
+void AddDirectIntensities(const MieCoefficients& c, double weight, const AngularTables& tables, std::span<double> out) {
+  constexpr size_t T = AngularTables::kTile;
+  const size_t half = tables.half(), n_out = 2 * half - 1, tiles = tables.tiles();
+  SKYBAKE_CHECK_EQ(out.size(), n_out);
+  SKYBAKE_CHECK_LE(c.terms, tables.max_terms());
+  const size_t n = static_cast<size_t>(c.terms);
+  thread_local std::vector<double> coef, plus, minus;
+  coef.resize(4 * n);
+  for (size_t j = 0; j < n; ++j) {
+    const double i = static_cast<double>(j + 1);
+    const double cn = (2.0 * i + 1.0) / (i * (i + 1.0));
+    const Complex alpha = cn * (c.a[j] + c.b[j]);
+    const Complex beta = cn * (c.a[j] - c.b[j]);
+    coef[4 * j] = alpha.real();
+    coef[4 * j + 1] = alpha.imag();
+    coef[4 * j + 2] = beta.real();
+    coef[4 * j + 3] = beta.imag();
+  }
+  plus.resize(tiles * T);
+  minus.resize(tiles * T);
+  detail::DirectSums(coef.data(), n, tables.Tile(0), tiles, static_cast<size_t>(tables.max_terms()) * AngularTables::kRow,
+                     plus.data(), minus.data());
+  for (size_t j = 0; j < half; ++j) {
+    out[j] += weight * 0.25 * plus[j];
+    if (j + 1 < half) out[n_out - 1 - j] += weight * 0.25 * minus[j];
+  }
+}
+
+IntensityAccumulator::IntensityAccumulator(int max_terms) { Reset(max_terms); }
+
+void IntensityAccumulator::Reset(int max_terms) {
   SKYBAKE_CHECK_GE(max_terms, 1);
+  n_ = max_terms;
+  stride_ = (static_cast<size_t>(max_terms) + 15) / 16 * 16;
+  ga_.assign(stride_ * stride_, 0.0);
+  gb_.assign(stride_ * stride_, 0.0);
+  buf_.assign(kBatch * 4 * stride_, 0.0);
+  wbuf_.assign(kBatch * 4 * stride_, 0.0);
+  slot_len_.assign(kBatch, 0);
+  count_ = 0;
+  batch_terms_ = 0;
+  used_ = 0;
 }
 
 void IntensityAccumulator::Add(const MieCoefficients& c, double weight) {
@@ -440,6 +553,20 @@ void IntensityAccumulator::Scale(double factor) {
   Flush();
   for (double& v : ga_) v *= factor;
   for (double& v : gb_) v *= factor;
+}
+
+void IntensityAccumulator::AddAccumulator(IntensityAccumulator& other) {
+  SKYBAKE_CHECK_LE(other.n_, n_);
+  Flush();
+  other.Flush();
+  const size_t rows = static_cast<size_t>(other.used_);
+  for (size_t i = 0; i < rows; ++i) {
+    for (size_t j = 0; j <= i; ++j) {
+      ga_[i * stride_ + j] += other.ga_[i * other.stride_ + j];
+      gb_[i * stride_ + j] += other.gb_[i * other.stride_ + j];
+    }
+  }
+  used_ = std::max(used_, other.used_);
 }
 
 void IntensityAccumulator::Evaluate(const AngularTables& tables, std::span<double> out) {

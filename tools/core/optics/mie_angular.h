@@ -69,12 +69,16 @@ class AngularTables {
 class IntensityAccumulator {
  public:
   explicit IntensityAccumulator(int max_terms);
+  // Empty again, for up to max_terms terms (keeps the memory: no new pages to fault in).
+  void Reset(int max_terms);
 
   // G += weight * (the radius' rank-2 terms). Radii are buffered and added in batches (in the
   // order given); Flush() is implied by Scale and Evaluate.
   void Add(const MieCoefficients& c, double weight);
   // G *= factor (the halving of nested trapezoid levels).
   void Scale(double factor);
+  // G += other's G (other may hold fewer terms): sums over disjoint sets of radii combine.
+  void AddAccumulator(IntensityAccumulator& other);
   // out[j] = sum_r w_r i_r(theta_j) for all 2 half - 1 grid angles.
   void Evaluate(const AngularTables& tables, std::span<double> out);
   int max_terms() const { return n_; }
@@ -82,8 +86,8 @@ class IntensityAccumulator {
  private:
   void Flush();
 
-  int n_;
-  size_t stride_;                // n_ rounded up to a multiple of 16 (row length of G and buffers)
+  int n_ = 0;
+  size_t stride_ = 0;                // n_ rounded up to a multiple of 16 (row length of G and buffers)
   std::vector<double> ga_, gb_;  // row-major, lower triangle used
   // Buffered radii (added in batches of kBatch, in order): per slot the real and imaginary parts
   // of alpha and beta (buf_) and the same times the weight (wbuf_), 4 arrays of stride_ values,
@@ -95,6 +99,11 @@ class IntensityAccumulator {
   std::vector<double> buf_, wbuf_;
   std::vector<size_t> slot_len_;  // entries of each slot that may be non-zero
 };
+
+// out[j] += weight * i(theta_j) of one sphere at every grid angle by the direct sums U, V above
+// (O(N) per angle, no Gram matrix): cheaper than an evaluation of G (O(N^2) per angle) when a
+// few spheres are added to intensities known already.
+void AddDirectIntensities(const MieCoefficients& c, double weight, const AngularTables& tables, std::span<double> out);
 
 namespace detail {
 // The Gram update's kernels (mie_angular.cpp; IntensityAccumulator calls the one the CPU
@@ -118,6 +127,17 @@ __attribute__((target("avx2"))) void GramEvaluateAvx2(const double* ga, const do
                                                       double* out);
 void GramEvaluateBaseline(const double* ga, const double* gb, size_t stride, size_t terms, const double* tables, size_t tiles,
                           size_t tile_stride, size_t half, double* out);
+// The direct sums' kernels (AddDirectIntensities; the same bits): per grid angle of the tiles in
+// [0, pi/2], plus = |U(+mu)|^2 + |V(+mu)|^2 and minus = |U(-mu)|^2 + |V(-mu)|^2 of one sphere from
+// coef (Re alpha, Im alpha, Re beta, Im beta of each of its n terms).
+__attribute__((target("avx512f"))) void DirectSumsAvx512(const double* coef, size_t n, const double* tables,
+                                                         size_t tiles, size_t tile_stride, double* plus, double* minus);
+__attribute__((target("avx2"))) void DirectSumsAvx2(const double* coef, size_t n, const double* tables, size_t tiles,
+                                                    size_t tile_stride, double* plus, double* minus);
+void DirectSumsBaseline(const double* coef, size_t n, const double* tables, size_t tiles, size_t tile_stride,
+                        double* plus, double* minus);
+void DirectSums(const double* coef, size_t n, const double* tables, size_t tiles, size_t tile_stride, double* plus,
+                double* minus);
 }  // namespace detail
 
 }  // namespace skybake::mie
