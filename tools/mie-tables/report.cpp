@@ -118,11 +118,11 @@ std::string BuildReportJson(const mie::ParticleType& type, const mie::MieBuild& 
     s += fmt::format(
         "{}\n    {{\"wavelength_nm\": {}, \"cext_m2\": {}, \"csca_m2\": {}, \"cabs_m2\": {}, \"ssa\": {}, \"g\": {}, "
         "\"phase_norm_error\": {}, \"radii\": {}, \"groups\": [{}], \"levels\": {}, \"last_change\": {}, "
-        "\"last_phase_change\": {}, \"largest_size_parameter\": {}, "
+        "\"last_phase_change\": {}, \"panel_change_sum\": {}, \"largest_size_parameter\": {}, "
         "\"hg\": {{\"g\": {}, {}}}, \"hg_moment\": {{{}}}, \"cs\": {{\"g\": {}, {}}}, "
         "\"dhg\": {{\"g1\": {}, \"g2\": {}, \"w\": {}, {}}}}}",
         w ? "," : "", Num(t.wavelength_nm[w]), Num(t.cext_m2[w]), Num(t.csca_m2[w]), Num(t.cabs_m2[w]), Num(t.ssa[w]),
-        Num(t.g[w]), Num(t.phase_norm_error[w]), mi.radii, groups, mi.levels, Num(mi.change), Num(mi.phase_change),
+        Num(t.g[w]), Num(t.phase_norm_error[w]), mi.radii, groups, mi.levels, Num(mi.change), Num(mi.phase_change), Num(mi.panel_change_sum),
         Num(mi.x_max), Num(fit.hg_g), Fit(fit.hg), Fit(fit.hg_moment), Num(fit.cs_g), Fit(fit.cs), Num(fit.dhg_g1),
         Num(fit.dhg_g2), Num(fit.dhg_w), Fit(fit.dhg));
   }

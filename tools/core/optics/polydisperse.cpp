@@ -2,9 +2,11 @@
 
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <numbers>
@@ -142,32 +144,33 @@ class Group {
     x_max_ = k_ * std::exp(panels_.back().b);
   }
 
-  // Nodes of level 0 (every interval end) or of level L >= 1 (the new midpoints).
-  void Nodes(int level, std::vector<Node>& out) const {
-    out.clear();
-    for (const Panel& p : panels_) {
-      const long intervals = static_cast<long>(p.n0) << level;
-      const double h = (p.b - p.a) / static_cast<double>(intervals);
-      if (level == 0) {
-        for (long i = 0; i <= intervals; ++i) {
-          const double u = i == intervals ? p.b : p.a + i * h;
-          const double w = (i == 0 || i == intervals ? 0.5 * h : h) * Density(p, u);
-          if (!out.empty() && out.back().u == u) out.back().w += w;  // shared panel end
-          else out.push_back({u, w});
-        }
-      } else {
-        for (long i = 0; i < intervals / 2; ++i) {
-          const double u = p.a + (2 * i + 1) * h;
-          out.push_back({u, h * Density(p, u)});
-        }
-      }
-    }
+  size_t panels() const { return panels_.size(); }
+  // Terms of the largest sphere in panel p (what its Gram matrices need).
+  int PanelTerms(size_t p) const { return WiscombeTerms(k_ * std::exp(panels_[p].b)); }
+  // Mie evaluations that refining panel p from `level` to level + 1 adds.
+  long NewNodes(size_t p, int level) const { return static_cast<long>(panels_[p].n0) << level; }
+  // Spacing in size parameter of panel p at `level`.
+  double XStep(size_t p, int level) const {
+    return panels_[p].x_span / static_cast<double>(static_cast<long>(panels_[p].n0) << level);
   }
 
-  double MaxXStep(int level) const {
-    double m = 0.0;
-    for (const Panel& p : panels_) m = std::max(m, p.x_span / static_cast<double>(static_cast<long>(p.n0) << level));
-    return m;
+  // Nodes of panel p at level 0 (every interval end) or at level L >= 1 (the new midpoints).
+  void Nodes(size_t p_index, int level, std::vector<Node>& out) const {
+    out.clear();
+    const Panel& p = panels_[p_index];
+    const long intervals = static_cast<long>(p.n0) << level;
+    const double h = (p.b - p.a) / static_cast<double>(intervals);
+    if (level == 0) {
+      for (long i = 0; i <= intervals; ++i) {
+        const double u = i == intervals ? p.b : p.a + i * h;
+        out.push_back({u, (i == 0 || i == intervals ? 0.5 * h : h) * Density(p, u)});
+      }
+    } else {
+      for (long i = 0; i < intervals / 2; ++i) {
+        const double u = p.a + (2 * i + 1) * h;
+        out.push_back({u, h * Density(p, u)});
+      }
+    }
   }
 
   std::complex<double> m() const { return m_; }
@@ -210,6 +213,27 @@ class Group {
   double x_min_ = 0.0, x_max_ = 0.0;
 };
 
+// One panel of one group during the refinement (header): its level, its trapezoid sums, their
+// changes at its last two refinements, and its own Gram matrices with their evaluation on the
+// check grid (the intensities' change, int |I_L - I_{L-1}| dOmega, is the panel's phase error).
+struct PanelRun {
+  size_t group = 0, panel = 0;
+  int level = -1;  // -1: no node yet
+  int terms = 0;
+  Sums t, change, change_before;
+  double l1 = 0.0, l1_before = 0.0;
+  IntensityAccumulator* acc = nullptr;  // in the workspace
+  std::vector<double> check, check_change;
+};
+
+// Spheres whose coefficients are computed together (mie_sphere.h: their recurrences overlap).
+constexpr size_t kSpheresPerBatch = 8;
+
+// C_ext, C_sca, C_abs, g C_sca and the phase function.
+constexpr size_t kQuantities = 5;
+// The bound on the sum of the panels' own estimates, in tolerances (header).
+constexpr double kPanelSumFactor = 3.0;
+
 }  // namespace
 
 double ModeMaxSizeParameter(const SizeMode& mode, double wavelength_nm, const QuadratureOptions& options) {
@@ -229,8 +253,11 @@ PhaseTables MakePhaseTables(const PhaseGrid& grid, int max_terms, size_t check_s
   return t;
 }
 
+// The adaptive radius quadrature of the header, in one function because the groups, their
+// panels' runs, the refinement and the stopping rule share one state: the panels' sums, Gram
+// matrices and check intensities, which only the final full-grid evaluation reads together.
 MixtureIntegral IntegrateMixture(std::span<const MixturePart> parts, double wavelength_nm, const PhaseTables* pt,
-                                 const QuadratureOptions& o) {
+                                 const QuadratureOptions& o, QuadratureWorkspace* workspace) {
   SKYBAKE_CHECK(!parts.empty());
   const double k = 2.0 * kPi / (wavelength_nm * 1e-9);
   // Group the parts by refractive index, in order of first appearance.
@@ -254,75 +281,194 @@ MixtureIntegral IntegrateMixture(std::span<const MixturePart> parts, double wave
   result.group_radii.assign(groups.size(), 0);
 
   const bool with_phase = pt != nullptr;
-  const size_t nc = with_phase ? pt->check_grid.size() : 0;
   const std::vector<double> omega = with_phase ? SolidAngleWeights(pt->check_grid) : std::vector<double>();
-  MieWorkspace ws;
-  MieCoefficients c;
-  std::optional<IntensityAccumulator> intensity;
-  if (with_phase) intensity.emplace(pt->tables.max_terms());
-  std::vector<Node> nodes;
-  Sums sums;
-  std::vector<double> check(nc, 0.0), check_prev;
-
-  // Adds sum w f over the nodes of `level` of every group to `acc` and `phase`.
-  auto evaluate = [&](int level, Sums& acc) {
-    for (size_t gi = 0; gi < groups.size(); ++gi) {
-      const Group& g = groups[gi];
-      g.Nodes(level, nodes);
-      for (const Node& node : nodes) {
-        const double r = std::exp(node.u);
-        ComputeCoefficients(k * r, g.m(), c, ws);
-        const MieEfficiencies q = Efficiencies(c);
-        const double wa = node.w * kPi * r * r;  // weight x geometric cross section
-        acc.ext += wa * q.qext;
-        acc.sca += wa * q.qsca;
-        acc.abs += wa * q.qabs;
-        acc.gsca += wa * q.gqsca;
-        if (with_phase) intensity->Add(c, node.w / (k * k));
+  QuadratureWorkspace local;
+  QuadratureWorkspace& space = workspace ? *workspace : local;
+  std::vector<PanelRun> runs;
+  for (size_t gi = 0; gi < groups.size(); ++gi) {
+    for (size_t p = 0; p < groups[gi].panels(); ++p) {
+      PanelRun run;
+      run.group = gi;
+      run.panel = p;
+      run.terms = groups[gi].PanelTerms(p);
+      if (with_phase) {
+        run.check.assign(pt->check_grid.size(), 0.0);
+        run.check_change.assign(pt->check_grid.size(), 0.0);
       }
-      result.group_radii[gi] += static_cast<int>(nodes.size());
-      result.radii += static_cast<int>(nodes.size());
+      runs.push_back(std::move(run));
     }
+  }
+  if (with_phase) {
+    if (space.panels.size() < runs.size()) space.panels.resize(runs.size(), IntensityAccumulator(1));
+    for (size_t i = 0; i < runs.size(); ++i) {
+      runs[i].acc = &space.panels[i];
+      runs[i].acc->Reset(runs[i].terms);
+    }
+  }
+
+  MieWorkspace ws;
+  std::array<MieCoefficients, kSpheresPerBatch> c;
+  std::array<double, kSpheresPerBatch> radius, x;
+  std::vector<Node> nodes;
+  std::vector<double> check_prev;
+  // Takes a panel to its next level: T_L = T_{L-1} / 2 + h_L sum over the new midpoints (the Gram
+  // matrices alike), and the changes of its sums and of its intensities on the check grid.
+  auto refine = [&](PanelRun& run) {
+    const Group& g = groups[run.group];
+    const int level = run.level + 1;
+    g.Nodes(run.panel, level, nodes);
+    Sums next;
+    if (level > 0) {
+      next = {0.5 * run.t.ext, 0.5 * run.t.sca, 0.5 * run.t.abs, 0.5 * run.t.gsca};
+      if (with_phase) run.acc->Scale(0.5);
+    }
+    // The check intensities: I_L = I_{L-1}/2 + the new spheres' direct sums when they are few
+    // (direct: ~8 N operations per sphere and angle; an evaluation of G: ~2 N^2 per angle, at a
+    // lower rate: measured, direct up to N/2 new spheres is the faster).
+    const bool direct = with_phase && 2 * nodes.size() < static_cast<size_t>(run.terms);
+    if (with_phase) {
+      check_prev = run.check;
+      if (direct && level > 0) {
+        for (double& v : run.check) v *= 0.5;
+      }
+    }
+    for (size_t first = 0; first < nodes.size(); first += kSpheresPerBatch) {
+      const size_t count = std::min(kSpheresPerBatch, nodes.size() - first);
+      for (size_t i = 0; i < count; ++i) {
+        radius[i] = std::exp(nodes[first + i].u);
+        x[i] = k * radius[i];
+      }
+      ComputeCoefficients(std::span<const double>(x.data(), count), g.m(), std::span<MieCoefficients>(c.data(), count), ws);
+      for (size_t i = 0; i < count; ++i) {
+        const double r = radius[i], w = nodes[first + i].w;
+        const MieEfficiencies q = Efficiencies(c[i]);
+        const double wa = w * kPi * r * r;  // weight x geometric cross section
+        next.ext += wa * q.qext;
+        next.sca += wa * q.qsca;
+        next.abs += wa * q.qabs;
+        next.gsca += wa * q.gqsca;
+        if (with_phase) {
+          run.acc->Add(c[i], w / (k * k));
+          if (direct) AddDirectIntensities(c[i], w / (k * k), pt->check_tables, run.check);
+        }
+      }
+    }
+    result.group_radii[run.group] += static_cast<int>(nodes.size());
+    result.radii += static_cast<int>(nodes.size());
+    if (with_phase && !direct) run.acc->Evaluate(pt->check_tables, run.check);
+    if (level > 0) {
+      run.change_before = run.change;
+      run.change = {next.ext - run.t.ext, next.sca - run.t.sca, next.abs - run.t.abs, next.gsca - run.t.gsca};
+      run.l1_before = run.l1;
+      run.l1 = 0.0;
+      for (size_t j = 0; j < run.check.size(); ++j) {
+        run.check_change[j] = run.check[j] - check_prev[j];
+        run.l1 += omega[j] * std::abs(run.check_change[j]);
+      }
+    }
+    run.t = next;
+    run.level = level;
   };
 
-  evaluate(0, sums);
-  if (with_phase) intensity->Evaluate(pt->check_tables, check);
-  for (int level = 1; level <= o.max_levels; ++level) {
-    Sums next{0.5 * sums.ext, 0.5 * sums.sca, 0.5 * sums.abs, 0.5 * sums.gsca};
-    if (with_phase) {
-      check_prev = check;
-      intensity->Scale(0.5);
+  // Every panel to the level where its spacing is at most x_step_accept, and at least 2 (two
+  // changes to estimate its error from) and min_levels.
+  for (PanelRun& run : runs) {
+    const Group& g = groups[run.group];
+    while (run.level < 2 || run.level < o.min_levels || g.XStep(run.panel, run.level) > o.x_step_accept) {
+      if (run.level >= o.max_levels) break;
+      refine(run);
     }
-    evaluate(level, next);
-    if (with_phase) intensity->Evaluate(pt->check_tables, check);
-    // Largest relative change of the integrals (see the header).
-    double change = std::abs(next.ext - sums.ext) / next.ext;
-    change = std::max(change, std::abs(next.sca - sums.sca) / next.sca);
-    change = std::max(change, std::abs(next.abs - sums.abs) / next.ext);
-    change = std::max(change, std::abs(next.gsca - sums.gsca) / next.sca);
-    double l1 = 0.0;
-    if (with_phase) {
-      for (size_t j = 0; j < nc; ++j) l1 += omega[j] * std::abs(check[j] / next.sca - check_prev[j] / sums.sca);
+  }
+
+  // The two error measures of the header, per quantity (C_ext, C_sca, C_abs, g C_sca, P): the
+  // change between the mixture and the mixture with every panel one level coarser (its sums less
+  // its last change), and the sum over the panels of each one's own estimate.
+  auto panel_estimate = [](const PanelRun& run, const Sums& total) {
+    auto e = [](double now, double before) { return std::max(std::abs(now), 0.5 * std::abs(before)); };
+    return std::array<double, kQuantities>{
+        e(run.change.ext, run.change_before.ext) / total.ext, e(run.change.sca, run.change_before.sca) / total.sca,
+        e(run.change.abs, run.change_before.abs) / total.ext, e(run.change.gsca, run.change_before.gsca) / total.sca,
+        e(run.l1, run.l1_before) / total.sca};
+  };
+  const size_t nc = with_phase ? pt->check_grid.size() : 0;
+  std::vector<double> i_now(nc), i_coarser(nc);
+  Sums total;
+  for (;;) {
+    Sums coarser;
+    total = Sums{};
+    std::fill(i_now.begin(), i_now.end(), 0.0);
+    std::fill(i_coarser.begin(), i_coarser.end(), 0.0);
+    for (const PanelRun& run : runs) {
+      total.ext += run.t.ext;
+      total.sca += run.t.sca;
+      total.abs += run.t.abs;
+      total.gsca += run.t.gsca;
+      coarser.ext += run.t.ext - run.change.ext;
+      coarser.sca += run.t.sca - run.change.sca;
+      coarser.abs += run.t.abs - run.change.abs;
+      coarser.gsca += run.t.gsca - run.change.gsca;
+      for (size_t j = 0; j < nc; ++j) {
+        i_now[j] += run.check[j];
+        i_coarser[j] += run.check[j] - run.check_change[j];
+      }
     }
-    change = std::max(change, l1);
-    double max_x_step = 0.0;
-    for (const Group& g : groups) max_x_step = std::max(max_x_step, g.MaxXStep(level));
-    sums = next;
-    result.levels = level;
-    result.change = change;
-    result.phase_change = l1;
-    if (level >= o.min_levels && change < o.tolerance && max_x_step <= o.x_step_accept) {
+    std::array<double, kQuantities> change{std::abs(total.ext - coarser.ext) / total.ext,
+                                           std::abs(total.sca - coarser.sca) / total.sca,
+                                           std::abs(total.abs - coarser.abs) / total.ext,
+                                           std::abs(total.gsca - coarser.gsca) / total.sca, 0.0};
+    for (size_t j = 0; j < nc; ++j) change[4] += omega[j] * std::abs(i_now[j] / total.sca - i_coarser[j] / coarser.sca);
+    std::array<double, kQuantities> panel_sum{};
+    for (const PanelRun& run : runs) {
+      const auto e = panel_estimate(run, total);
+      for (size_t q = 0; q < kQuantities; ++q) panel_sum[q] += e[q];
+    }
+    // The quantity furthest from its bounds.
+    size_t worst = 0;
+    double worst_ratio = -1.0;
+    for (size_t q = 0; q < kQuantities; ++q) {
+      const double ratio = std::max(change[q] / o.tolerance, panel_sum[q] / (kPanelSumFactor * o.tolerance));
+      if (ratio > worst_ratio) {
+        worst_ratio = ratio;
+        worst = q;
+      }
+    }
+    result.change = *std::max_element(change.begin(), change.end());
+    result.phase_change = change[4];
+    result.panel_change_sum = *std::max_element(panel_sum.begin(), panel_sum.end());
+    if (worst_ratio < 1.0) {
       result.converged = true;
       break;
     }
+    // The panel whose refinement removes the most of that quantity's estimated error per
+    // operation: its new nodes and one evaluation on the check grid, each ~ terms^2.
+    PanelRun* best = nullptr;
+    double best_score = -1.0;
+    for (PanelRun& run : runs) {
+      const double work = static_cast<double>(groups[run.group].NewNodes(run.panel, run.level + 1)) +
+                          static_cast<double>(nc);
+      const double score = panel_estimate(run, total)[worst] / (work * run.terms * run.terms);
+      if (score > best_score) {
+        best_score = score;
+        best = &run;
+      }
+    }
+    if (best->level >= o.max_levels) break;
+    refine(*best);
   }
-  result.cext_m2 = sums.ext;
-  result.csca_m2 = sums.sca;
-  result.cabs_m2 = sums.abs;
-  result.gcsca_m2 = sums.gsca;
+
+  for (const PanelRun& run : runs) result.levels = std::max(result.levels, run.level);
+  result.cext_m2 = total.ext;
+  result.csca_m2 = total.sca;
+  result.cabs_m2 = total.abs;
+  result.gcsca_m2 = total.gsca;
   if (with_phase) {
+    int terms = 1;
+    for (const PanelRun& run : runs) terms = std::max(terms, run.terms);
+    IntensityAccumulator& sum = space.sum;
+    sum.Reset(terms);
+    for (PanelRun& run : runs) sum.AddAccumulator(*run.acc);
     result.dcsca_domega_m2_sr.assign(pt->grid.size(), 0.0);
-    intensity->Evaluate(pt->tables, result.dcsca_domega_m2_sr);
+    sum.Evaluate(pt->tables, result.dcsca_domega_m2_sr);
   }
   return result;
 }
@@ -401,13 +547,14 @@ MieBuild BuildMieTable(const ParticleType& type, std::span<const double> wavelen
   std::vector<std::optional<Diagnostic>> failures(nw);
 
   std::atomic<size_t> done{0};
+  tbb::enumerable_thread_specific<QuadratureWorkspace> workspaces;
   ReportProgress(progress, "mie", 0.0);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, nw, 1), [&](const tbb::blocked_range<size_t>& range) {
     for (size_t w = range.begin(); w != range.end(); ++w) {
       const double wl = wavelengths[w];
       std::vector<MixturePart> parts;
       for (size_t i = 0; i < nm; ++i) parts.push_back({&type.modes[i], fraction[i], type.modes[i].index.At(wl)});
-      MixtureIntegral mi = IntegrateMixture(parts, wl, &tables, options.quadrature);
+      MixtureIntegral mi = IntegrateMixture(parts, wl, &tables, options.quadrature, &workspaces.local());
       if (!mi.converged) {
         failures[w] = Diagnostic{type.modes.front().loc,
                                  fmt::format("at {} nm the radius quadrature did not converge to {:g} (last change "

@@ -27,11 +27,25 @@
 //     exact composite trapezoid on its own domain. Panel p gets n_p = max(1, ceil(Delta x_p / 2))
 //     intervals at level 0 (Delta x_p its size-parameter span): the spacing adapts to the size
 //     parameter, at most 2 in x and s/2 in u;
-//   - each level halves every interval (nested: only the new midpoints are computed);
-//   - converged when, between two levels, the mixture's C_ext, C_sca, C_abs (relative to C_ext),
-//     g C_sca (relative to C_sca) and phase function (L1 distance int |P_L - P_{L-1}| dOmega)
-//     all change by less than `tolerance` (1e-4) relative, and the spacing is at most 0.5 in x
-//     (2 nodes per ripple period or more, so that under-sampled ripple cannot look converged).
+//   - each panel has its own level; a refinement halves its intervals (nested: only the new
+//     midpoints are computed, T_L = T_{L-1}/2 + h_L sum f(new)). Every panel starts at the level
+//     where its spacing is at most 0.5 in x (2 nodes per ripple period or more, so that
+//     under-sampled ripple cannot look converged), and at least 2;
+//   - each panel keeps its own sums and Gram matrices (mie_angular.h), so its change at its last
+//     refinement is known for every integral: for the phase function the L1 change of its
+//     intensities, int |I_L - I_{L-1}| dOmega / C_sca, on a check grid (every 16th angle of the
+//     table's grid, mirrored); its error estimate is max(|last change|, |change before| / 2),
+//     which a change that happens to be small at one level does not hide;
+//   - converged when, for the mixture's C_ext, C_sca, C_abs (relative to C_ext), g C_sca
+//     (relative to C_sca) and phase function (L1 distance int |P - P'| dOmega), both
+//       the change between the mixture and the mixture with every panel one level coarser
+//       (P' from those coarser sums) is less than `tolerance` (1e-4), and
+//       the sum over the panels of their estimates is less than 3 `tolerance`
+//     (the second bound keeps a cancellation between panels from passing for convergence; the
+//     factor 3 is measured, docs/mie.md). Until then, the panel whose refinement removes the
+//     most of the estimate of the integral furthest from its bounds per operation (new nodes and
+//     one check evaluation, each ~ its terms^2) is refined: the spacing follows where the
+//     integrand has weight, not only the size parameter.
 //     The criterion is on the integrals the table stores (the mixture's), not on each mode:
 //     a mode holding 5 % of the extinction needs only 2e-3 of its own.
 #pragma once
@@ -59,15 +73,15 @@ struct QuadratureOptions {
   int min_levels = 0;              // refine at least this many times (tests of convergence)
 };
 
-// The angle grid, its p_n/q_n tables, and a coarser grid (every 4th angle of [0, pi/2], and
-// pi/2) on which the phase function's convergence is checked between levels; the full grid is
-// evaluated once, at the converged level. The L1 distance on the coarse grid is a trapezoid
+// The angle grid, its p_n/q_n tables, and a coarser grid (every 16th angle of [0, pi/2], and
+// pi/2, mirrored) on which the phase function's convergence is checked at every refinement; the
+// full grid is evaluated once, when converged. The L1 distance on the coarse grid is a trapezoid
 // estimate of the same integral.
 struct PhaseTables {
   PhaseGrid grid, check_grid;
   AngularTables tables, check_tables;
 };
-PhaseTables MakePhaseTables(const PhaseGrid& grid, int max_terms, size_t check_stride = 4);
+PhaseTables MakePhaseTables(const PhaseGrid& grid, int max_terms, size_t check_stride = 16);
 
 // One component of a mixture: a mode, its number fraction in the mixture and its index at the
 // wavelength.
@@ -84,16 +98,25 @@ struct MixtureIntegral {
   int radii = 0;        // Mie evaluations in all (nodes of the final level, every group)
   std::vector<int> group_radii;  // per refractive-index group, in order of first appearance
   std::vector<std::string> group_modes;  // the modes of each group, "+"-joined
-  int levels = 0;       // refinements after level 0
-  double change = 0.0;  // largest relative change at the last refinement
+  int levels = 0;       // the finest panel's level (refinements after level 0)
+  double change = 0.0;  // largest relative change against every panel one level coarser
   double phase_change = 0.0;  // its phase-function part (L1)
+  double panel_change_sum = 0.0;  // largest sum over the panels of their own estimates
   double x_min = 0.0, x_max = 0.0;  // size-parameter range integrated
   bool converged = false;
 };
 
-// The mixture at one wavelength. `phase` may be null (no phase function then).
+// Scratch memory of IntegrateMixture (every panel's Gram matrices), reused by the calls of one
+// thread so that a table build does not fault in fresh pages per wavelength.
+struct QuadratureWorkspace {
+  std::vector<IntensityAccumulator> panels;
+  IntensityAccumulator sum{1};
+};
+
+// The mixture at one wavelength. `phase` may be null (no phase function then); `workspace` may be
+// null (a local one then).
 MixtureIntegral IntegrateMixture(std::span<const MixturePart> parts, double wavelength_nm, const PhaseTables* phase,
-                                 const QuadratureOptions& options);
+                                 const QuadratureOptions& options, QuadratureWorkspace* workspace = nullptr);
 // One mode alone (fraction 1).
 MixtureIntegral IntegrateMode(const SizeMode& mode, double wavelength_nm, std::complex<double> m,
                               const PhaseTables* phase, const QuadratureOptions& options);
