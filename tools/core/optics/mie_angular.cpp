@@ -280,10 +280,12 @@ void GramUpdate(double* ga, double* gb, size_t stride, size_t terms, const doubl
 }
 
 // out[j] = (p^T G_A p + q^T G_B q)/4 at +mu_j and (q~^T G_A q~ + p~^T G_B p~)/4 at -mu_j, using
-// x^T G x = sum_n x_n (G_nn x_n + 2 sum_{n' < n} G_nn' x_n'); the inner sums run in four
-// interleaved partial sums (n' mod 4) to hide the addition latency. NT tiles of angles share
-// each pass over G (one broadcast of G_nn' serves NT tiles), so G is read once per NT tiles;
-// every lane's operations are those of a one-tile pass.
+// x^T G x = sum_n x_n (G_nn x_n + 2 sum_{n' < n} G_nn' x_n'). Per row n the inner sum runs in two
+// partial sums (n' even, n' odd; an odd row's last column n - 1 goes to the even one), and the
+// rows are visited in pairs (n, n + 1), n even, which share the loads of the tables' columns:
+// the table loads, not the arithmetic, bound this kernel. NT tiles of angles share each pass over
+// G (one broadcast of G_nn' serves NT tiles). Every lane's operations are those of the plain
+// row-by-row loop with those two partial sums, in the 8-lane and the 4-lane forms alike.
 template <size_t NT>
 __attribute__((always_inline)) inline void EvaluateTiles(const double* ga, const double* gb, size_t stride,
                                                          size_t terms, const double* tiles0, size_t tile_stride,
@@ -296,42 +298,61 @@ __attribute__((always_inline)) inline void EvaluateTiles(const double* ga, const
     const size_t part = which == 0 ? 0 : 2 * T;  // (p, q~) with G_A; (q, p~) with G_B
     V8 acc_x[NT], acc_y[NT];
     for (size_t t = 0; t < NT; ++t) acc_x[t] = acc_y[t] = Splat8(0.0);
-    for (size_t row = 0; row < terms; ++row) {
-      const double* gr = g + row * stride;
-      V8 sx0[NT], sx1[NT], sx2[NT], sx3[NT], sy0[NT], sy1[NT], sy2[NT], sy3[NT];
+    size_t row = 0;
+    for (; row + 2 <= terms; row += 2) {
+      const double* g0 = g + row * stride;  // rows n = row (even) and n + 1
+      const double* g1 = g0 + stride;
+      V8 ax0[NT], ax1[NT], ay0[NT], ay1[NT], bx0[NT], bx1[NT], by0[NT], by1[NT];
       for (size_t t = 0; t < NT; ++t) {
-        sx0[t] = sx1[t] = sx2[t] = sx3[t] = sy0[t] = sy1[t] = sy2[t] = sy3[t] = Splat8(0.0);
+        ax0[t] = ax1[t] = ay0[t] = ay1[t] = bx0[t] = bx1[t] = by0[t] = by1[t] = Splat8(0.0);
       }
-      size_t c = 0;
-      for (; c + 4 <= row; c += 4) {
-        const V8 g0 = Splat8(gr[c]), g1 = Splat8(gr[c + 1]), g2 = Splat8(gr[c + 2]), g3 = Splat8(gr[c + 3]);
+      for (size_t c = 0; c < row; c += 2) {
+        const V8 a0 = Splat8(g0[c]), a1 = Splat8(g0[c + 1]), b0 = Splat8(g1[c]), b1 = Splat8(g1[c + 1]);
         for (size_t t = 0; t < NT; ++t) {
           const double* tt = tiles0 + t * tile_stride + part + c * R;
-          sx0[t] += g0 * Load8(tt);
-          sy0[t] += g0 * Load8(tt + T);
-          sx1[t] += g1 * Load8(tt + R);
-          sy1[t] += g1 * Load8(tt + R + T);
-          sx2[t] += g2 * Load8(tt + 2 * R);
-          sy2[t] += g2 * Load8(tt + 2 * R + T);
-          sx3[t] += g3 * Load8(tt + 3 * R);
-          sy3[t] += g3 * Load8(tt + 3 * R + T);
+          const V8 x0 = Load8(tt), y0 = Load8(tt + T), x1 = Load8(tt + R), y1 = Load8(tt + R + T);
+          ax0[t] += a0 * x0;
+          ay0[t] += a0 * y0;
+          ax1[t] += a1 * x1;
+          ay1[t] += a1 * y1;
+          bx0[t] += b0 * x0;
+          by0[t] += b0 * y0;
+          bx1[t] += b1 * x1;
+          by1[t] += b1 * y1;
         }
       }
-      for (; c < row; ++c) {
-        const V8 gv = Splat8(gr[c]);
-        for (size_t t = 0; t < NT; ++t) {
-          const double* tt = tiles0 + t * tile_stride + part + c * R;
-          sx0[t] += gv * Load8(tt);
-          sy0[t] += gv * Load8(tt + T);
-        }
-      }
-      const V8 gd = Splat8(gr[row]);
+      const V8 bl = Splat8(g1[row]), d0 = Splat8(g0[row]), d1 = Splat8(g1[row + 1]);
       for (size_t t = 0; t < NT; ++t) {
         const double* tt = tiles0 + t * tile_stride + part + row * R;
-        const V8 sx = (sx0[t] + sx1[t]) + (sx2[t] + sx3[t]), sy = (sy0[t] + sy1[t]) + (sy2[t] + sy3[t]);
-        const V8 x = Load8(tt), y = Load8(tt + T);
-        acc_x[t] += x * (gd * x + 2.0 * sx);
-        acc_y[t] += y * (gd * y + 2.0 * sy);
+        const V8 x0 = Load8(tt), y0 = Load8(tt + T), x1 = Load8(tt + R), y1 = Load8(tt + R + T);
+        bx0[t] += bl * x0;  // row n + 1's last column, n
+        by0[t] += bl * y0;
+        acc_x[t] += x0 * (d0 * x0 + 2.0 * (ax0[t] + ax1[t]));
+        acc_y[t] += y0 * (d0 * y0 + 2.0 * (ay0[t] + ay1[t]));
+        acc_x[t] += x1 * (d1 * x1 + 2.0 * (bx0[t] + bx1[t]));
+        acc_y[t] += y1 * (d1 * y1 + 2.0 * (by0[t] + by1[t]));
+      }
+    }
+    if (row < terms) {  // the last row alone (even: its columns pair up)
+      const double* g0 = g + row * stride;
+      V8 ax0[NT], ax1[NT], ay0[NT], ay1[NT];
+      for (size_t t = 0; t < NT; ++t) ax0[t] = ax1[t] = ay0[t] = ay1[t] = Splat8(0.0);
+      for (size_t c = 0; c < row; c += 2) {
+        const V8 a0 = Splat8(g0[c]), a1 = Splat8(g0[c + 1]);
+        for (size_t t = 0; t < NT; ++t) {
+          const double* tt = tiles0 + t * tile_stride + part + c * R;
+          ax0[t] += a0 * Load8(tt);
+          ay0[t] += a0 * Load8(tt + T);
+          ax1[t] += a1 * Load8(tt + R);
+          ay1[t] += a1 * Load8(tt + R + T);
+        }
+      }
+      const V8 d0 = Splat8(g0[row]);
+      for (size_t t = 0; t < NT; ++t) {
+        const double* tt = tiles0 + t * tile_stride + part + row * R;
+        const V8 x0 = Load8(tt), y0 = Load8(tt + T);
+        acc_x[t] += x0 * (d0 * x0 + 2.0 * (ax0[t] + ax1[t]));
+        acc_y[t] += y0 * (d0 * y0 + 2.0 * (ay0[t] + ay1[t]));
       }
     }
     for (size_t t = 0; t < NT; ++t) {
@@ -381,33 +402,50 @@ __attribute__((always_inline)) inline void EvaluateQuarterLanes(const double* ga
     const double* g = which == 0 ? ga : gb;
     const double* tp = tile + (which == 0 ? 0 : 2 * T) + h;
     V4 acc_x = zero, acc_y = zero;
-    for (size_t row = 0; row < terms; ++row) {
-      const double* gr = g + row * stride;
-      V4 sx0 = zero, sx1 = zero, sx2 = zero, sx3 = zero, sy0 = zero, sy1 = zero, sy2 = zero, sy3 = zero;
-      size_t c = 0;
-      for (; c + 4 <= row; c += 4) {
+    size_t row = 0;
+    for (; row + 2 <= terms; row += 2) {
+      const double* g0 = g + row * stride;
+      const double* g1 = g0 + stride;
+      V4 ax0 = zero, ax1 = zero, ay0 = zero, ay1 = zero, bx0 = zero, bx1 = zero, by0 = zero, by1 = zero;
+      for (size_t c = 0; c < row; c += 2) {
         const double* tt = tp + c * R;
-        const double g0 = gr[c], g1 = gr[c + 1], g2 = gr[c + 2], g3 = gr[c + 3];
-        sx0 += g0 * Load4(tt);
-        sy0 += g0 * Load4(tt + T);
-        sx1 += g1 * Load4(tt + R);
-        sy1 += g1 * Load4(tt + R + T);
-        sx2 += g2 * Load4(tt + 2 * R);
-        sy2 += g2 * Load4(tt + 2 * R + T);
-        sx3 += g3 * Load4(tt + 3 * R);
-        sy3 += g3 * Load4(tt + 3 * R + T);
+        const double a0 = g0[c], a1 = g0[c + 1], b0 = g1[c], b1 = g1[c + 1];
+        const V4 x0 = Load4(tt), y0 = Load4(tt + T), x1 = Load4(tt + R), y1 = Load4(tt + R + T);
+        ax0 += a0 * x0;
+        ay0 += a0 * y0;
+        ax1 += a1 * x1;
+        ay1 += a1 * y1;
+        bx0 += b0 * x0;
+        by0 += b0 * y0;
+        bx1 += b1 * x1;
+        by1 += b1 * y1;
       }
-      for (; c < row; ++c) {
-        const double* tt = tp + c * R;
-        sx0 += gr[c] * Load4(tt);
-        sy0 += gr[c] * Load4(tt + T);
-      }
-      const double gd = gr[row];
+      const double bl = g1[row], d0 = g0[row], d1 = g1[row + 1];
       const double* tt = tp + row * R;
-      const V4 sx = (sx0 + sx1) + (sx2 + sx3), sy = (sy0 + sy1) + (sy2 + sy3);
-      const V4 x = Load4(tt), y = Load4(tt + T);
-      acc_x += x * (gd * x + 2.0 * sx);
-      acc_y += y * (gd * y + 2.0 * sy);
+      const V4 x0 = Load4(tt), y0 = Load4(tt + T), x1 = Load4(tt + R), y1 = Load4(tt + R + T);
+      bx0 += bl * x0;
+      by0 += bl * y0;
+      acc_x += x0 * (d0 * x0 + 2.0 * (ax0 + ax1));
+      acc_y += y0 * (d0 * y0 + 2.0 * (ay0 + ay1));
+      acc_x += x1 * (d1 * x1 + 2.0 * (bx0 + bx1));
+      acc_y += y1 * (d1 * y1 + 2.0 * (by0 + by1));
+    }
+    if (row < terms) {
+      const double* g0 = g + row * stride;
+      V4 ax0 = zero, ax1 = zero, ay0 = zero, ay1 = zero;
+      for (size_t c = 0; c < row; c += 2) {
+        const double* tt = tp + c * R;
+        const double a0 = g0[c], a1 = g0[c + 1];
+        ax0 += a0 * Load4(tt);
+        ay0 += a0 * Load4(tt + T);
+        ax1 += a1 * Load4(tt + R);
+        ay1 += a1 * Load4(tt + R + T);
+      }
+      const double d0 = g0[row];
+      const double* tt = tp + row * R;
+      const V4 x0 = Load4(tt), y0 = Load4(tt + T);
+      acc_x += x0 * (d0 * x0 + 2.0 * (ax0 + ax1));
+      acc_y += y0 * (d0 * y0 + 2.0 * (ay0 + ay1));
     }
     *plus += acc_x;
     *minus += acc_y;
