@@ -85,6 +85,10 @@ Domain QuadratureDomain(const SizeMode& mode, double k, const QuadratureOptions&
   return {lo, std::min(hi, b)};
 }
 
+// A panel spans at least this much of ln r (pieces join until it does, header): the panels'
+// number bounds the memory of their Gram matrices.
+constexpr double kMinPanelWidth = 0.05;
+
 // The modes sharing one refractive index, on one radius grid.
 class Group {
  public:
@@ -127,17 +131,26 @@ class Group {
       if (merged.empty() || v - merged.back() > 1e-12 * std::max(1.0, std::abs(v))) merged.push_back(v);
     }
     for (size_t i = 0; i + 1 < merged.size(); ++i) {
-      Panel pn;
-      pn.a = merged[i];
-      pn.b = merged[i + 1];
-      const double mid = 0.5 * (pn.a + pn.b);
+      Piece pc;
+      pc.a = merged[i];
+      pc.b = merged[i + 1];
+      const double mid = 0.5 * (pc.a + pc.b);
       for (size_t j = 0; j < parts_.size(); ++j) {
-        if (mid >= parts_[j].lo && mid <= parts_[j].hi) pn.active.push_back(j);
+        if (mid >= parts_[j].lo && mid <= parts_[j].hi) pc.active.push_back(j);
       }
-      if (pn.active.empty()) continue;
-      pn.x_span = k_ * (std::exp(pn.b) - std::exp(pn.a));
-      pn.n0 = std::max(1, static_cast<int>(std::ceil(pn.x_span / o_.x_step_start)));
-      panels_.push_back(pn);
+      if (pc.active.empty()) continue;
+      pc.x_span = k_ * (std::exp(pc.b) - std::exp(pc.a));
+      pc.n0 = std::max(1, static_cast<int>(std::ceil(pc.x_span / o_.x_step_start)));
+      // A piece joins the panel before it while that panel is narrower than kMinPanelWidth and
+      // ends where the piece begins.
+      if (!panels_.empty() && panels_.back().b == pc.a && panels_.back().b - panels_.back().a < kMinPanelWidth) {
+        panels_.back().b = pc.b;
+        panels_.back().x_span += pc.x_span;
+        panels_.back().n0 += pc.n0;
+      } else {
+        panels_.push_back(Panel{pc.a, pc.b, pc.x_span, pc.n0, {}});
+      }
+      panels_.back().pieces.push_back(std::move(pc));
     }
     SKYBAKE_CHECK(!panels_.empty());
     x_min_ = k_ * std::exp(panels_.front().a);
@@ -149,26 +162,34 @@ class Group {
   int PanelTerms(size_t p) const { return WiscombeTerms(k_ * std::exp(panels_[p].b)); }
   // Mie evaluations that refining panel p from `level` to level + 1 adds.
   long NewNodes(size_t p, int level) const { return static_cast<long>(panels_[p].n0) << level; }
-  // Spacing in size parameter of panel p at `level`.
+  // Largest spacing in size parameter of panel p's pieces at `level`.
   double XStep(size_t p, int level) const {
-    return panels_[p].x_span / static_cast<double>(static_cast<long>(panels_[p].n0) << level);
+    double step = 0.0;
+    for (const Piece& pc : panels_[p].pieces) {
+      step = std::max(step, pc.x_span / static_cast<double>(static_cast<long>(pc.n0) << level));
+    }
+    return step;
   }
 
-  // Nodes of panel p at level 0 (every interval end) or at level L >= 1 (the new midpoints).
+  // Nodes of panel p at level 0 (every interval end) or at level L >= 1 (the new midpoints),
+  // piece by piece.
   void Nodes(size_t p_index, int level, std::vector<Node>& out) const {
     out.clear();
-    const Panel& p = panels_[p_index];
-    const long intervals = static_cast<long>(p.n0) << level;
-    const double h = (p.b - p.a) / static_cast<double>(intervals);
-    if (level == 0) {
-      for (long i = 0; i <= intervals; ++i) {
-        const double u = i == intervals ? p.b : p.a + i * h;
-        out.push_back({u, (i == 0 || i == intervals ? 0.5 * h : h) * Density(p, u)});
-      }
-    } else {
-      for (long i = 0; i < intervals / 2; ++i) {
-        const double u = p.a + (2 * i + 1) * h;
-        out.push_back({u, h * Density(p, u)});
+    for (const Piece& p : panels_[p_index].pieces) {
+      const long intervals = static_cast<long>(p.n0) << level;
+      const double h = (p.b - p.a) / static_cast<double>(intervals);
+      if (level == 0) {
+        for (long i = 0; i <= intervals; ++i) {
+          const double u = i == intervals ? p.b : p.a + i * h;
+          const double w = (i == 0 || i == intervals ? 0.5 * h : h) * Density(p, u);
+          if (!out.empty() && out.back().u == u) out.back().w += w;  // shared piece end
+          else out.push_back({u, w});
+        }
+      } else {
+        for (long i = 0; i < intervals / 2; ++i) {
+          const double u = p.a + (2 * i + 1) * h;
+          out.push_back({u, h * Density(p, u)});
+        }
       }
     }
   }
@@ -183,14 +204,21 @@ class Group {
     double s = 0.0, mu = 0.0, scale = 0.0, lo = 0.0, hi = 0.0;
     const SizeTable* table = nullptr;  // a tabulated mode (then s, mu are unused)
   };
-  struct Panel {
+  // A piece of the partition: inside or outside each part's domain as a whole.
+  struct Piece {
     double a, b, x_span;
     int n0;
     std::vector<size_t> active;
   };
+  // A panel: consecutive pieces refined together (one level, one set of Gram matrices).
+  struct Panel {
+    double a, b, x_span;
+    int n0;  // intervals at level 0, over its pieces
+    std::vector<Piece> pieces;
+  };
 
   // sum over the parts active in the panel of f_i n_i(u).
-  double Density(const Panel& p, double u) const {
+  double Density(const Piece& p, double u) const {
     double d = 0.0;
     for (size_t j : p.active) {
       const Part& part = parts_[j];

@@ -22,11 +22,14 @@
 //   - a tabulated mode's domain is its table's [r_1, r_n], its pieces the table's intervals (the
 //     density is linear in ln r on each, size_table.h), so the trapezoid meets no kink inside
 //     a panel;
-//   - panels: the union of every mode's partition of its domain into pieces of width <= s/2;
-//     each panel lies wholly inside or outside each mode's domain, so a truncated mode is the
-//     exact composite trapezoid on its own domain. Panel p gets n_p = max(1, ceil(Delta x_p / 2))
+//   - pieces: the union of every mode's partition of its domain into pieces of width <= s/2;
+//     each piece lies wholly inside or outside each mode's domain, so a truncated mode is the
+//     exact composite trapezoid on its own domain. Piece p gets n_p = max(1, ceil(Delta x_p / 2))
 //     intervals at level 0 (Delta x_p its size-parameter span): the spacing adapts to the size
 //     parameter, at most 2 in x and s/2 in u;
+//   - panels: consecutive pieces joined until a panel spans at least 0.05 in u (a table's fine
+//     intervals, slivers between two modes' boundaries): a panel is refined as one and holds
+//     one pair of Gram matrices, so the panels' number bounds the memory;
 //   - each panel has its own level; a refinement halves its intervals (nested: only the new
 //     midpoints are computed, T_L = T_{L-1}/2 + h_L sum f(new)). Every panel starts at the level
 //     where its spacing is at most 0.5 in x (2 nodes per ripple period or more, so that
