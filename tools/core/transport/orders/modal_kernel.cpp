@@ -17,6 +17,7 @@
 // end's columns serve both (half of D: 9 MB per radius for high instead of 18 MB). The same
 // values as the matrix to float rounding (test MethodOrders.ModalKernelIsTheMatrixKernel).
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "transport/orders/kernel.h"
@@ -147,13 +148,22 @@ void ModesFromCoefficients(const KernelContext& kc, size_t ri, const std::vector
   }
 }
 
-void BuildModalKernel(const KernelContext& kc, const ScatterKernels& sk, size_t ri, float* G, float* D) {
+// A thread's double coefficients of one radius (54 MB for high): zeroed anew for each radius in
+// memory the thread keeps, not allocated per radius (fresh pages of that size cost a page fault
+// each and are zeroed by the kernel before the vector zeroes them again).
+struct CoefficientScratch {
+  std::vector<double> c, dc;
+};
+
+void BuildModalKernel(const KernelContext& kc, const ScatterKernels& sk, size_t ri, float* G, float* D, CoefficientScratch* x) {
   const size_t nw = kc.md->nw, nu = kc.nodes->nu, N = 2 * static_cast<size_t>(kc.s->nphi);
   const double r = kc.nodes->radius[ri];
   const std::vector<float> mix = kc.Mixture(ri);
   const ViewNodes vn = kc.ViewNodesAt(r);
-  std::vector<double> c(nu * nu * N * nw, 0.0);  // c[((k * nu + k2) * N + d) * nw + w]
-  std::vector<double> dc(sk.end_floats, 0.0);
+  std::vector<double>& c = x->c;  // c[((k * nu + k2) * N + d) * nw + w]
+  std::vector<double>& dc = x->dc;
+  c.assign(nu * nu * N * nw, 0.0);
+  dc.assign(sk.end_floats, 0.0);
   if (kc.s->kernel_sub == 0) CoefficientsAtNodes(kc, vn, mix, &c);
   else CoefficientsOfBasis(kc, r, vn, mix, sk.has_ends, &c, &dc);
   ModesFromCoefficients(kc, ri, c, dc, G, D);
@@ -174,11 +184,16 @@ void BuildModalKernels(const KernelContext& kc, ScatterKernels* sk) {
   sk->end_floats = sk->has_ends ? nu * nphi * nu * nw : 0;
   ZeroTable(&sk->modal_kernels, nr * sk->modal_floats);
   ZeroTable(&sk->end_kernels, nr * sk->end_floats);
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, nr, 1), [&](const tbb::blocked_range<size_t>& rg) {
-    for (size_t ri = rg.begin(); ri != rg.end(); ++ri) {
-      BuildModalKernel(kc, *sk, ri, &sk->modal_kernels[ri * sk->modal_floats], sk->has_ends ? &sk->end_kernels[ri * sk->end_floats] : nullptr);
-    }
-  });
+  {
+    tbb::enumerable_thread_specific<CoefficientScratch> scratch;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, nr, 1), [&](const tbb::blocked_range<size_t>& rg) {
+      CoefficientScratch& x = scratch.local();
+      for (size_t ri = rg.begin(); ri != rg.end(); ++ri) {
+        BuildModalKernel(kc, *sk, ri, &sk->modal_kernels[ri * sk->modal_floats], sk->has_ends ? &sk->end_kernels[ri * sk->end_floats] : nullptr,
+                         &x);
+      }
+    });
+  }  // the scratch is freed before the solve's tables are allocated (the peak, docs/sky-methods.md "Peak memory")
 }
 
 // The three products run 8 wavelengths wide (simd.h), each sum in the order of the plain loops
