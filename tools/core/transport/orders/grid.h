@@ -17,10 +17,15 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kDeg = kPi / 180.0;
 
 // The solve's tables (a field over every cell and wavelength: 88 MB for high's daylight part) in
-// vectors whose elements start uninitialised, zeroed in parallel by ZeroTable: a
-// std::vector<float> of that size is zeroed on one thread, and so is the kernel's zeroing of the
-// fresh pages on first touch (seconds of system time for high's fields and kernels). The same
-// values, the same bytes.
+// vectors whose elements start uninitialised. Blocks of at least kMapFrom bytes are their own
+// anonymous mappings made with MAP_POPULATE: the kernel hands them over zeroed and resident in
+// one call, where touching fresh pages faults once per 4 KB (on a virtual machine each fault
+// traps to the hypervisor: 4.5 % of the hazed LUT's CPU time, with as much again in the zeroing
+// that followed) - so ZeroTable need not write them. Smaller blocks come from operator new and
+// ZeroTable zeroes them in parallel blocks. The same values, the same bytes.
+void* MapZeroedPages(size_t bytes);           // throws std::bad_alloc
+void UnmapPages(void* p, size_t bytes);
+inline constexpr size_t kMapFrom = size_t{16} << 20;
 template <class T>
 struct UninitAllocator : std::allocator<T> {
   template <class U>
@@ -38,10 +43,19 @@ struct UninitAllocator : std::allocator<T> {
   void construct(U* p, A&&... a) {
     ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
   }
+  T* allocate(size_t n) {
+    if (n * sizeof(T) < kMapFrom) return std::allocator<T>::allocate(n);
+    return static_cast<T*>(MapZeroedPages(n * sizeof(T)));
+  }
+  void deallocate(T* p, size_t n) noexcept {
+    if (n * sizeof(T) < kMapFrom) std::allocator<T>::deallocate(p, n);
+    else UnmapPages(p, n * sizeof(T));
+  }
 };
 using Table = std::vector<float, UninitAllocator<float>>;
 
-// v = n zeros, written in parallel blocks (the first touch of fresh pages spread over the threads).
+// v = n zeros: a fresh mapping (zeroed by the kernel) from kMapFrom bytes, else written in
+// parallel blocks.
 void ZeroTable(Table* v, size_t n);
 
 // Linear interpolation position on a sorted grid: index of the lower node and weight of the upper.
