@@ -30,7 +30,7 @@ TEST(OrdersTables, ZeroTableGivesZerosBelowAndAboveTheMappingSize) {
   }
 }
 
-TEST(OrdersTables, MappedTablesCopyMoveAndSwapLikeVectors) {
+TEST(OrdersTables, MappedTablesCopyAndSwapLikeVectors) {
   const size_t n = kMapFrom / sizeof(float) + 3;
   Table a, b;
   ZeroTable(&a, n);

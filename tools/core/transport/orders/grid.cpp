@@ -20,7 +20,7 @@ void UnmapPages(void* p, size_t bytes) { munmap(p, bytes); }
 void ZeroTable(Table* v, size_t n) {
   Table().swap(*v);
   v->resize(n);  // a capacity of at least n: a fresh mapping whenever n floats reach kMapFrom
-  if (n * sizeof(float) >= kMapFrom) return;
+  if (IsMappedBlock(n * sizeof(float))) return;
   constexpr size_t kBlock = size_t{1} << 18;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, (n + kBlock - 1) / kBlock, 1), [&](const tbb::blocked_range<size_t>& rg) {
     for (size_t b = rg.begin(); b != rg.end(); ++b) std::fill(v->begin() + b * kBlock, v->begin() + std::min(n, (b + 1) * kBlock), 0.0f);

@@ -26,6 +26,8 @@ constexpr double kDeg = kPi / 180.0;
 void* MapZeroedPages(size_t bytes);           // throws std::bad_alloc
 void UnmapPages(void* p, size_t bytes);
 inline constexpr size_t kMapFrom = size_t{16} << 20;
+// Whether a block of `bytes` is its own zeroed mapping (the allocator's and ZeroTable's one rule).
+inline constexpr bool IsMappedBlock(size_t bytes) { return bytes >= kMapFrom; }
 template <class T>
 struct UninitAllocator : std::allocator<T> {
   template <class U>
@@ -44,11 +46,11 @@ struct UninitAllocator : std::allocator<T> {
     ::new (static_cast<void*>(p)) U(std::forward<A>(a)...);
   }
   T* allocate(size_t n) {
-    if (n * sizeof(T) < kMapFrom) return std::allocator<T>::allocate(n);
+    if (!IsMappedBlock(n * sizeof(T))) return std::allocator<T>::allocate(n);
     return static_cast<T*>(MapZeroedPages(n * sizeof(T)));
   }
   void deallocate(T* p, size_t n) noexcept {
-    if (n * sizeof(T) < kMapFrom) std::allocator<T>::deallocate(p, n);
+    if (!IsMappedBlock(n * sizeof(T))) std::allocator<T>::deallocate(p, n);
     else UnmapPages(p, n * sizeof(T));
   }
 };
