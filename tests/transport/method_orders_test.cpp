@@ -534,7 +534,7 @@ TEST(MethodOrders, ThickCloudLayerConvergesWithinItsMeasuredError) {
     std::printf("thick layer, dir %zu: orders %.5g path %.5g +- %.1f %%: %+.1f %%\n", d, y, ref[d].xyz[1],
                 100.0 * ref[d].xyz_stderr[1] / ref[d].xyz[1], 100.0 * e);
     EXPECT_TRUE(std::isfinite(y) && y > 0.0);
-    // Measured -0.4, +0.3, +1.5, +4.3 % (path 2 %).
+    // Measured +1.9, +0.3, +4.4, +6.3 % (path 2 %).
     EXPECT_LT(std::abs(e), 0.07) << "dir " << d;
   }
 }
@@ -561,10 +561,12 @@ TEST(MethodOrders, TableRayStepsConvergeThroughAThickLayer) {
   }
 }
 
-// Under cloudy5's deck (water droplets, optical depth 16) the orders converge: the geometric tail
-// is taken, and capping the orders at 40 or 80 gives the same sky: the table rays' step weights
-// conserve energy, so each order adds less than the last and the tail settles. Measured: 40 vs 80
-// orders within 0.01 % (pipeline grid); this grid (40 nm) within the bound below.
+// Under cloudy5's deck (water droplets, optical depth 16) the orders converge: the table rays'
+// step weights conserve energy, so each order adds less than the last and the ratio of
+// successive orders settles (at ~0.955 at 600 nm). medium runs to its 40-order cap and ends with
+// the dominant mode's tail, every element at its wavelength's observer ratio (solve.cpp,
+// TakeTail); 40 orders and the tail against 90 orders and theirs (a tail 20x smaller). Measured
+// on this grid (40 nm): within 0.04 %; with the per-element tail at the cap 0.2-0.3 %.
 TEST(MethodOrders, OrdersConvergeUnderAThickWaterCloud) {
   SceneOptions so;
   so.step_nm = 40.0;
@@ -574,17 +576,22 @@ TEST(MethodOrders, OrdersConvergeUnderAThickWaterCloud) {
   for (int i = 0; i < 2; ++i) {
     SkyMethodOptions o;
     o.quality = Quality::kMedium;
-    o.orders = i == 0 ? 40 : 80;
+    o.orders = i == 0 ? 40 : 90;
+    if (i == 1) {
+      o.order_tolerance = 1e-7;
+      o.table_size["early_tail"] = 0;
+    }
     const auto m = MakeSkyMethod("orders", sc.model, o, {});
     const std::string desc = m->Describe();
     std::printf("max orders %d:\n%s", o.orders, desc.c_str());
-    EXPECT_NE(desc.find("tail_extrapolated: true"), std::string::npos) << "the orders did not settle";
+    EXPECT_NE(desc.find("orders_computed: " + std::to_string(o.orders)), std::string::npos) << "the cap was not reached";
+    EXPECT_NE(desc.find("tail_extrapolated: true (dominant mode)"), std::string::npos) << "the orders did not settle";
     y[i] = MethodY(sc, *m, 30.0, dirs);
   }
   for (size_t d = 0; d < dirs.size(); ++d) {
-    std::printf("dir %zu: Y %.6g (40 orders) %.6g (80)\n", d, y[0][d], y[1][d]);
+    std::printf("dir %zu: Y %.6g (40 orders) %.6g (90): %+.3f %%\n", d, y[0][d], y[1][d], 100.0 * (y[0][d] / y[1][d] - 1.0));
     EXPECT_GT(y[0][d], 0.0);
-    EXPECT_NEAR(y[1][d] / y[0][d], 1.0, 0.01) << d;
+    EXPECT_NEAR(y[0][d] / y[1][d], 1.0, 0.003) << d;
   }
 }
 

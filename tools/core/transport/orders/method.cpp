@@ -32,10 +32,11 @@ class OrdersSolve {
     return fmt::format(
         "{0}radius_nodes: {1}\n{0}view_nodes: {2} up + {3} down per altitude\n{0}azimuth_nodes: {4}\n"
         "{0}sun_nodes: {5}\n{0}ray_steps: {6}\n{0}view_steps: {7}\n{0}truncation_deg: {8}\n{0}kernel: {9}\n{0}orders_computed: {10}\n"
-        "{0}tail_extrapolated: {11}\n{0}last_order_fraction: {12:.3g}\n{0}tolerance: {13}\n{0}single_scattering_attenuation: {14}\n",
+        "{0}tail_extrapolated: {11}{15}\n{0}last_order_fraction: {12:.3g}\n{0}tolerance: {13}\n{0}single_scattering_attenuation: {14}\n",
         prefix, nodes_.radius.size(), s_.nup, s_.ndn, s_.nphi, SunNodesText(), s_.nt, s_.nss, md_.ConesText(),
         s_.kernel_sub > 0 ? fmt::format("basis-integrated, {} sub-intervals", s_.kernel_sub) : std::string("phase at the nodes"),
-        res_.orders_done, res_.tail ? "true" : "false", res_.last_fraction, s_.tolerance, ss_scaled_ ? "delta-scaled" : "unscaled");
+        res_.orders_done, res_.tail ? "true" : "false", res_.last_fraction, s_.tolerance, ss_scaled_ ? "delta-scaled" : "unscaled",
+        res_.dominant_tail ? " (dominant mode)" : "");
   }
 
   void Render(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,

@@ -96,42 +96,71 @@ struct OrderTables {
 };
 
 // The ratio history of the stopping rule (norms of successive orders at the observer, reference
-// wavelength).
+// wavelength; and every wavelength's norm of the last order, for the dominant-mode tail).
 struct RatioHistory {
   double prev_norm = 0.0, prev_ratio = -1.0, prev_prev_ratio = -1.0;
+  std::vector<double> prev_norm_w;
+};
+
+// How the series stops with its geometric tail (TakeTail, AddTail).
+enum class Tail {
+  kNone,
+  kPerElement,  // each element's own ratio where it has settled, the observer's elsewhere
+  kDominant,    // every element at its wavelength's observer ratio: the dominant mode's decay
 };
 
 // Geometric tail once the ratio of successive orders has settled: the remaining orders sum to
 // L_n rho / (1 - rho), and an error d_rho in rho changes that by about fraction_n d_rho /
-// (1 - rho)^2 of the total; stop when that is below the tolerance and the tail is at most
-// tail_share_max (10 %) of the total, or at the last allowed order if the ratio has settled at
-// all. The share limit: in a thick layer the ratio creeps up over many orders while each step of
-// it is small (a tail taken at order 16 of a tau-8 cloud is 4-5 % short of the converged sum).
-// d_rho is the larger of the last two changes of the ratio: with one, a ratio passing an extremum
-// looks settled (the hazed sky's ratios 0.521, 0.503, 0.503 at orders 3-5, going on to 0.52 by
-// order 12, would take the tail at order 5: 2.2 % RMS at sun 70 deg instead of 0.6 %).
-// Returns whether to stop with the tail after this order.
-bool TakeTail(const OrdersSettings& s, int order, double fraction, double ratio, const RatioHistory& h) {
+// (1 - rho)^2 of the total; stop when that is below the tolerance. d_rho is the larger of the
+// last two changes of the ratio: with one, a ratio passing an extremum looks settled (the hazed
+// sky's ratios 0.521, 0.503, 0.503 at orders 3-5, going on to 0.52 by order 12, would take the
+// tail at order 5: 2.2 % RMS at sun 70 deg instead of 0.6 %).
+//  - A tail of at most tail_share_max (10 %) of the total is taken early, per element
+//    (kPerElement): a thin sky's tail comes while its elements still decay at their own rates.
+//    The share limit: in a thick layer the ratio settles while modes other than the dominant one
+//    still matter, which the test on d_rho does not see (cloudy5 at high: the ratio settles to
+//    1e-5 by order 28, yet the dominant-mode tail taken there is 0.6 % RMS, max -0.9 %, off
+//    the sky of 100 orders at sun 70 deg; at order 25 1.2 %, max -1.8 %; bench_orders_tail).
+//  - At the last allowed order, if the ratio has settled at all, the dominant mode's tail
+//    (kDominant): every element at its wavelength's observer ratio. After many orders every
+//    element decays at the dominant eigenvalue of its wavelength's kernel (the orders do not mix
+//    wavelengths), while element ratios are still drifting towards it: under cloudy5's deck at
+//    order 25 a per-element tail is 7.6 % RMS off the sky of 59 orders and their tail at sun 70 deg
+//    (a tail of 87 % at worst from elements whose ratio is near 1), the dominant mode's 1.2 %.
+//    The eigenvalue differs between wavelengths (cloudy5: 0.955 at 600 nm, 0.973 at 780 nm), so
+//    the reference wavelength's ratio would put the wrong tail on the others.
+Tail TakeTail(const OrdersSettings& s, int order, double fraction, double ratio, const RatioHistory& h) {
   const bool settled = ratio > 0.0 && ratio < 1.0 && h.prev_ratio > 0.0;
+  if (!settled) return Tail::kNone;
   const double d_rho = std::max(std::abs(ratio - h.prev_ratio), h.prev_prev_ratio > 0.0 ? std::abs(h.prev_ratio - h.prev_prev_ratio) : 1.0);
-  const double tail_error = settled ? fraction * d_rho / ((1.0 - ratio) * (1.0 - ratio)) : 1.0;
-  const double tail_share = settled ? fraction * ratio / (1.0 - ratio) : 1.0;
-  const bool early = settled && s.early_tail && order >= 5 && tail_error < s.tolerance && tail_share <= s.tail_share_max;
-  return early || (order == s.max_orders && settled && std::abs(ratio - h.prev_ratio) < 0.02);
+  const double tail_error = fraction * d_rho / ((1.0 - ratio) * (1.0 - ratio));
+  const double tail_share = fraction * ratio / (1.0 - ratio);
+  if (s.early_tail && order >= 5 && tail_error < s.tolerance && tail_share <= s.tail_share_max) return Tail::kPerElement;
+  if (order == s.max_orders && std::abs(ratio - h.prev_ratio) < 0.02) return Tail::kDominant;
+  return Tail::kNone;
 }
 
-// Adds the geometric tail sum_{k>n} L_k ~ L_n rho / (1 - rho) to ms and jms, with rho per table
-// element (the horizon and the shadowed sky decay more slowly than the observer's average: with
-// one global rho the hazed horizon misses 0.55 % at tolerance 1e-3, within 0.3 % per element;
-// tests/transport/method_orders_test.cpp): the element's L_n / L_{n-1} where that and
-// L_{n-1} / L_{n-2} agree within 0.05 and are below 1, the observer's global ratio elsewhere (an
-// element whose orders still grow - the low-sun horizon's at order 4 - would get a tail of 9 L_n
-// from its own ratio and come out 60 % bright). The sources J_n decay like the radiances of their
-// node. rho is capped at rho_cap (0.98: tail <= 49 L_n). Here Lnext = L_n, L = L_{n-1} and
-// ratio codes L_{n-1} / L_{n-2}.
-void AddTail(const Nodes& nodes, const OrdersSettings& s, size_t nd, double ratio, const OrderTables& t, SolveResult* out) {
+// Adds the geometric tail sum_{k>n} L_k ~ L_n rho / (1 - rho) to ms and jms; the sources J_n
+// decay like the radiances of their node. rho is capped at rho_cap (0.98: tail <= 49 L_n).
+//  - kDominant: rho = ratio_w[w], the observer's ratio at the element's wavelength (TakeTail).
+//  - kPerElement: rho per table element (the horizon and the shadowed sky decay more slowly than
+//    the observer's average: with one global rho the hazed horizon misses 0.55 % at tolerance
+//    1e-3, within 0.3 % per element; tests/transport/method_orders_test.cpp): the element's
+//    L_n / L_{n-1} where that and L_{n-1} / L_{n-2} agree within 0.05 and are below 1, the
+//    observer's ratio at the reference wavelength elsewhere (an element whose orders still grow -
+//    the low-sun horizon's at order 4 - would get a tail of 9 L_n from its own ratio and come out
+//    60 % bright).
+// Here Lnext = L_n, L = L_{n-1} and ratio codes L_{n-1} / L_{n-2}.
+void AddTail(const Nodes& nodes, const OrdersSettings& s, size_t nd, Tail kind, double ratio, const std::vector<double>& ratio_w,
+             const OrderTables& t, SolveResult* out) {
   const size_t nw = nodes.nw, ns = nodes.ns;
+  std::vector<float> dominant(nw);
+  for (size_t w = 0; w < nw; ++w) {
+    const double rho = std::clamp(ratio_w[w], 0.0, s.rho_cap);
+    dominant[w] = static_cast<float>(rho / (1.0 - rho));
+  }
   auto tail_at = [&](size_t e) {
+    if (kind == Tail::kDominant) return dominant[e % nw];
     const double r1 = t.L[e] > 0.0f ? t.Lnext[e] / static_cast<double>(t.L[e]) : 2.0;
     const uint8_t c0 = t.ratio[e];
     double rho = r1 < 1.0 && c0 != kRatioNone && std::abs(r1 - RatioOfCode(c0)) < 0.05 ? r1 : ratio;
@@ -151,17 +180,22 @@ void AddTail(const Nodes& nodes, const OrdersSettings& s, size_t nd, double rati
   out->tail = true;
 }
 
-// Adds L (order n) at the observer radius to ms; returns its norm at the reference wavelength and
-// sets *total to the accumulated one.
-double AccumulateAtObserver(const Nodes& nodes, size_t nd, const Table& L, std::vector<float>* ms, double* total) {
+// Adds L (order n) at the observer radius to ms; returns its norm at the reference wavelength,
+// sets *total to the accumulated one and norm_w to the norm at every wavelength.
+double AccumulateAtObserver(const Nodes& nodes, size_t nd, const Table& L, std::vector<float>* ms, double* total,
+                            std::vector<double>* norm_w) {
   const size_t nw = nodes.nw, ns = nodes.ns, wref = nw / 2;
   double norm = 0.0;
   *total = 0.0;
+  norm_w->assign(nw, 0.0);
   for (size_t si = 0; si < ns; ++si) {
     for (size_t i = 0; i < nd; ++i) {
       const float* v = &L[(((nodes.obs_index * ns + si) * nd) + i) * nw];
       float* a = &(*ms)[((si * nd) + i) * nw];
-      for (size_t w = 0; w < nw; ++w) a[w] += v[w];
+      for (size_t w = 0; w < nw; ++w) {
+        a[w] += v[w];
+        (*norm_w)[w] += v[w];
+      }
       norm += v[wref];
       *total += a[wref];
     }
@@ -193,6 +227,7 @@ SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, 
   ZeroTable(&out.jms, cells * nw);
   const size_t nd = nodes.nu * nphi;  // directions per (radius, sun)
   RatioHistory h;
+  std::vector<double> norm_w, ratio_w(nw);
   for (int order = 2; order <= s.max_orders; ++order) {
     ReportProgress(progress, fmt::format("orders: order {}", order), 0.0);
     Scatter(kc, sk, t.L, &t.J);
@@ -202,18 +237,22 @@ SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, 
     Transport(tc, t.J, t.L, &t.Lnext);
     // Accumulate L_n (Lnext) at the observer radius; convergence on the reference wavelength.
     double total = 0.0;
-    const double norm = AccumulateAtObserver(nodes, nd, t.Lnext, &out.ms, &total);
+    const double norm = AccumulateAtObserver(nodes, nd, t.Lnext, &out.ms, &total, &norm_w);
     out.orders_done = order;
     out.last_fraction = total > 0.0 ? norm / total : 0.0;
     const double ratio = h.prev_norm > 0.0 ? norm / h.prev_norm : -1.0;
     if (out.last_fraction < s.tolerance) break;
-    if (TakeTail(s, order, out.last_fraction, ratio, h)) {
-      AddTail(nodes, s, nd, ratio, t, &out);
+    const Tail tail = TakeTail(s, order, out.last_fraction, ratio, h);
+    if (tail != Tail::kNone) {
+      for (size_t w = 0; w < nw; ++w) ratio_w[w] = h.prev_norm_w[w] > 0.0 ? norm_w[w] / h.prev_norm_w[w] : ratio;
+      AddTail(nodes, s, nd, tail, ratio, ratio_w, t, &out);
+      out.dominant_tail = tail == Tail::kDominant;
       break;
     }
     h.prev_prev_ratio = h.prev_ratio;
     h.prev_ratio = ratio;
     h.prev_norm = norm;
+    h.prev_norm_w = norm_w;
     // Next order: ratio codes L_n / L_{n-1}, then L = L_n.
     tbb::parallel_for(tbb::blocked_range<size_t>(0, t.ratio.size(), size_t{1} << 18), [&](const tbb::blocked_range<size_t>& rg) {
       for (size_t i = rg.begin(); i != rg.end(); ++i) t.ratio[i] = RatioCode(t.Lnext[i], t.L[i]);

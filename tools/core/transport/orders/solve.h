@@ -22,6 +22,7 @@ struct SolveResult {
   Table jms;
   int orders_done = 0;
   bool tail = false;
+  bool dominant_tail = false;  // the tail at the observer's ratio per wavelength (solve.cpp, TakeTail)
   double last_fraction = 0.0;
 };
 
