@@ -23,6 +23,7 @@ struct SolveResult {
   int orders_done = 0;
   bool tail = false;
   bool dominant_tail = false;  // the tail at the observer's ratio per wavelength (solve.cpp, TakeTail)
+  bool two_mode_tail = false;  // the tail of the dominant mode and the next (solve.cpp, SecondMode)
   double last_fraction = 0.0;
 };
 
