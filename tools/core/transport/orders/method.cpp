@@ -35,8 +35,8 @@ class OrdersSolve {
         "{0}tail_extrapolated: {11}{15}\n{0}last_order_fraction: {12:.3g}\n{0}tolerance: {13}\n{0}single_scattering_attenuation: {14}\n",
         prefix, nodes_.radius.size(), s_.nup, s_.ndn, s_.nphi, SunNodesText(), s_.nt, s_.nss, md_.ConesText(),
         s_.kernel_sub > 0 ? fmt::format("basis-integrated, {} sub-intervals", s_.kernel_sub) : std::string("phase at the nodes"),
-        res_.orders_done, res_.tail ? "true" : "false", res_.last_fraction, s_.tolerance, ss_scaled_ ? "delta-scaled" : "unscaled",
-        res_.dominant_tail ? " (dominant mode)" : res_.two_mode_tail ? " (two modes)" : "");
+        res_.orders_done, res_.tail != orders::Tail::kNone ? "true" : "false", res_.last_fraction, s_.tolerance, ss_scaled_ ? "delta-scaled" : "unscaled",
+        res_.tail == orders::Tail::kDominant ? " (dominant mode)" : res_.tail == orders::Tail::kTwoModes ? " (two modes)" : "");
   }
 
   void Render(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,

@@ -102,13 +102,12 @@ struct RatioHistory {
   std::vector<double> prev_norm_w;
 };
 
-// How the series stops with its geometric tail (TakeTail, AddTail).
-enum class Tail {
-  kNone,
-  kPerElement,  // each element's own ratio where it has settled, the observer's elsewhere
-  kDominant,    // every element at its wavelength's observer ratio: the dominant mode's decay
-  kTwoModes,    // the dominant mode's and the next one's (SecondMode, AddTwoModeTail)
-};
+// The error of the geometric tail from the ratio's last two changes, fraction_n d_rho /
+// (1 - rho)^2 of the total (TakeTail); ratio settled (in (0, 1), with a ratio before it).
+double RatioTailError(double fraction, double ratio, const RatioHistory& h) {
+  const double d_rho = std::max(std::abs(ratio - h.prev_ratio), h.prev_prev_ratio > 0.0 ? std::abs(h.prev_ratio - h.prev_prev_ratio) : 1.0);
+  return fraction * d_rho / ((1.0 - ratio) * (1.0 - ratio));
+}
 
 // Geometric tail once the ratio of successive orders has settled: the remaining orders sum to
 // L_n rho / (1 - rho), and an error d_rho in rho changes that by about fraction_n d_rho /
@@ -135,8 +134,7 @@ enum class Tail {
 Tail TakeTail(const OrdersSettings& s, int order, double fraction, double ratio, const RatioHistory& h) {
   const bool settled = ratio > 0.0 && ratio < 1.0 && h.prev_ratio > 0.0;
   if (!settled) return Tail::kNone;
-  const double d_rho = std::max(std::abs(ratio - h.prev_ratio), h.prev_prev_ratio > 0.0 ? std::abs(h.prev_ratio - h.prev_prev_ratio) : 1.0);
-  const double tail_error = fraction * d_rho / ((1.0 - ratio) * (1.0 - ratio));
+  const double tail_error = RatioTailError(fraction, ratio, h);
   const double tail_share = fraction * ratio / (1.0 - ratio);
   if (s.early_tail && order >= 5 && tail_error < s.tolerance && tail_share <= s.tail_share_max) return Tail::kPerElement;
   if (order == s.max_orders && std::abs(ratio - h.prev_ratio) < 0.02) return Tail::kDominant;
@@ -180,7 +178,7 @@ void AddTail(const Nodes& nodes, const OrdersSettings& s, size_t nd, Tail kind, 
   tbb::parallel_for(tbb::blocked_range<size_t>(0, out->jms.size(), size_t{1} << 18), [&](const tbb::blocked_range<size_t>& rg) {
     for (size_t i = rg.begin(); i != rg.end(); ++i) out->jms[i] += tail_at(i) * t.J[i];
   });
-  out->tail = true;
+  out->tail = kind;
 }
 
 // The second mode of a thick sky's series. With the dominant ratio lambda (per wavelength, at the
@@ -197,13 +195,11 @@ struct SecondMode {
   std::vector<double> lambda, mu;  // per wavelength
   double fraction = 1.0;           // sum |D_n| / ((1 - lambda) total) at the reference wavelength
 };
-SecondMode EstimateSecondMode(const Nodes& nodes, size_t nd, double ratio, const std::vector<double>& norm_w,
-                              const std::vector<double>& prev_norm_w, const Table& L, const Table& Lnext,
-                              const std::vector<float>& obs_before, double total) {
+SecondMode EstimateSecondMode(const Nodes& nodes, size_t nd, double ratio, const std::vector<double>& lambda, const Table& L,
+                              const Table& Lnext, const std::vector<float>& obs_before, double total) {
   const size_t nw = nodes.nw, n = nodes.ns * nd * nw, e0 = nodes.obs_index * n;
   SecondMode m;
-  m.lambda.resize(nw);
-  for (size_t w = 0; w < nw; ++w) m.lambda[w] = prev_norm_w[w] > 0.0 ? norm_w[w] / prev_norm_w[w] : ratio;
+  m.lambda = lambda;
   std::vector<double> dn(nw, 0.0), dm(nw, 0.0);
   for (size_t j = 0; j < n; ++j) {
     const size_t w = j % nw;
@@ -249,22 +245,24 @@ void AddTwoModeTail(const KernelContext& kc, const ScatterKernels& sk, const Nod
   tbb::parallel_for(tbb::blocked_range<size_t>(0, out->jms.size(), size_t{1} << 18), [&](const tbb::blocked_range<size_t>& rg) {
     for (size_t i = rg.begin(); i != rg.end(); ++i) out->jms[i] += t->J[i];
   });
-  out->tail = true;
+  out->tail = Tail::kTwoModes;
 }
 
-// Whether to stop with the two modes' tail: the tail too large a share for the early
-// per-element one (TakeTail), the dominant ratio settled to the tolerance (the error
-// fraction_n d_rho / (1 - rho)^2 of TakeTail), mu below it by 0.02 at least and settled so that
-// its error moves the next mode's part by less than the tolerance (fraction_D |d_mu| / (1 - mu)^2).
-bool TakeTwoModes(const OrdersSettings& s, int order, double fraction, double ratio, const RatioHistory& h, double mu,
-                  double prev_mu, double d_fraction) {
-  if (!s.early_tail || order < 5 || !(ratio > 0.0 && ratio < 1.0) || !(h.prev_ratio > 0.0) || !(h.prev_prev_ratio > 0.0)) return false;
-  if (fraction * ratio / (1.0 - ratio) <= s.tail_share_max) return false;
+// Whether the two modes' tail may be considered: the tail too large a share for the early
+// per-element one (TakeTail) and the ratio settled, from order 5.
+bool TwoModesApply(const OrdersSettings& s, int order, double fraction, double ratio, const RatioHistory& h) {
+  return s.early_tail && order >= 5 && ratio > 0.0 && ratio < 1.0 && h.prev_ratio > 0.0 && h.prev_prev_ratio > 0.0 &&
+         fraction * ratio / (1.0 - ratio) > s.tail_share_max;
+}
+
+// Whether to stop with it: the dominant ratio settled to the tolerance (RatioTailError), mu below
+// it by 0.02 at least and settled so that its error moves the next mode's part by less than the
+// tolerance (fraction_D |d_mu| / (1 - mu)^2).
+bool TakeTwoModes(const OrdersSettings& s, double fraction, double ratio, const RatioHistory& h, double mu, double prev_mu,
+                  double d_fraction) {
   if (!(mu > 0.0 && mu < ratio - 0.02 && prev_mu > 0.0)) return false;
-  const double d_rho = std::max(std::abs(ratio - h.prev_ratio), std::abs(h.prev_ratio - h.prev_prev_ratio));
-  const double rho_error = fraction * d_rho / ((1.0 - ratio) * (1.0 - ratio));
   const double mu_error = d_fraction * std::abs(mu - prev_mu) / ((1.0 - mu) * (1.0 - mu));
-  return rho_error < s.tolerance && mu_error < s.tolerance;
+  return RatioTailError(fraction, ratio, h) < s.tolerance && mu_error < s.tolerance;
 }
 
 // Adds L (order n) at the observer radius to ms; returns its norm at the reference wavelength,
@@ -331,22 +329,22 @@ SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, 
     out.last_fraction = total > 0.0 ? norm / total : 0.0;
     const double ratio = h.prev_norm > 0.0 ? norm / h.prev_norm : -1.0;
     if (out.last_fraction < s.tolerance) break;
+    for (size_t w = 0; w < nw; ++w) ratio_w[w] = h.prev_norm_w.empty() || !(h.prev_norm_w[w] > 0.0) ? ratio : norm_w[w] / h.prev_norm_w[w];
     const Tail tail = TakeTail(s, order, out.last_fraction, ratio, h);
     if (tail != Tail::kNone) {
-      for (size_t w = 0; w < nw; ++w) ratio_w[w] = h.prev_norm_w[w] > 0.0 ? norm_w[w] / h.prev_norm_w[w] : ratio;
       AddTail(nodes, s, nd, tail, ratio, ratio_w, t, &out);
-      out.dominant_tail = tail == Tail::kDominant;
       break;
     }
-    if (!obs_before.empty()) {
-      const SecondMode sm = EstimateSecondMode(nodes, nd, ratio, norm_w, h.prev_norm_w, t.L, t.Lnext, obs_before, total);
+    if (!obs_before.empty() && TwoModesApply(s, order, out.last_fraction, ratio, h)) {
+      const SecondMode sm = EstimateSecondMode(nodes, nd, ratio, ratio_w, t.L, t.Lnext, obs_before, total);
       const double mu = sm.mu[nw / 2];
-      if (TakeTwoModes(s, order, out.last_fraction, ratio, h, mu, prev_mu, sm.fraction)) {
+      if (TakeTwoModes(s, out.last_fraction, ratio, h, mu, prev_mu, sm.fraction)) {
         AddTwoModeTail(kc, sk, nodes, s, nd, sm, &t, &out);
-        out.two_mode_tail = true;
         break;
       }
       prev_mu = mu;
+    } else {
+      prev_mu = -1.0;
     }
     h.prev_prev_ratio = h.prev_ratio;
     h.prev_ratio = ratio;

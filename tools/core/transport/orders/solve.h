@@ -15,15 +15,22 @@
 
 namespace skybake::orders {
 
+// How the series ended: by the tolerance or the cap without a tail, or with a geometric tail of
+// one of three forms (solve.cpp: TakeTail, AddTail, SecondMode).
+enum class Tail {
+  kNone,
+  kPerElement,  // each element's own ratio where it has settled, the observer's elsewhere
+  kDominant,    // every element at its wavelength's observer ratio: the dominant mode's decay
+  kTwoModes,    // the dominant mode's and the next one's
+};
+
 struct SolveResult {
   std::vector<float> ms;  // accumulated orders >= 2 at the observer radius: [(si*nu+k)*nphi+q]*nw
   // Accumulated multiple-scattering source J_ms* = sum_{n>=2} J_n at every node (cells x nw),
   // for view segments: L_seg,ms = int_0^t_end T* J_ms* dt.
   Table jms;
   int orders_done = 0;
-  bool tail = false;
-  bool dominant_tail = false;  // the tail at the observer's ratio per wavelength (solve.cpp, TakeTail)
-  bool two_mode_tail = false;  // the tail of the dominant mode and the next (solve.cpp, SecondMode)
+  Tail tail = Tail::kNone;
   double last_fraction = 0.0;
 };
 
