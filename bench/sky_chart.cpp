@@ -52,10 +52,14 @@ double Seconds(Clock::time_point t0) { return std::chrono::duration<double>(Cloc
 // The reference's path-tracer settings per sun elevation: 0.5 % standard error of Y in daylight,
 // 1 % near the horizon, 2 % at -4 deg and 5 % at -10 deg, where rare multiple-scattering paths
 // through the sunlit upper atmosphere dominate (more paths at least, docs/sky-render.md).
-PathTracerSettings ReferenceSettings(double elevation_deg) {
+// `daylight_error` > 0 replaces the targets from 0 deg up (the cloudy skies' references: 1 %,
+// docs/sky-render.md "Clouds").
+PathTracerSettings ReferenceSettings(double elevation_deg, double daylight_error = 0.0) {
   PathTracerSettings s;
   s.min_paths = 256;
-  if (elevation_deg >= 10) {
+  if (elevation_deg >= 0 && daylight_error > 0) {
+    s.target_relative_error = daylight_error;
+  } else if (elevation_deg >= 10) {
     s.target_relative_error = 0.005;
   } else if (elevation_deg >= 0) {
     s.target_relative_error = 0.01;
@@ -143,6 +147,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> atmospheres = {"clear", "hazed"};
   std::vector<double> elevations = {60, 20, 5, 0, -4, -10};
   bool no_variants = false, references_only = false;
+  double reference_error = 0.0;
   std::vector<std::string> methods;
   std::vector<std::string> qualities = QualityNames();
   cli.app().add_option("--out", out_dir, "Output folder (CSV; references cached in <out>/references)");
@@ -151,6 +156,11 @@ int main(int argc, char** argv) {
   cli.app().add_option("--elevations", elevations, "Sun elevations (deg)")->delimiter(',');
   cli.app().add_flag("--no-variants", no_variants, "Skip the model simplifications");
   cli.app().add_flag("--references-only", references_only, "Only render (or check) the cached references");
+  cli.app()
+      .add_option("--reference-error", reference_error,
+                  "Target relative standard error of the references from sun elevation 0 up (default: 0.5 % from 10 deg, "
+                  "1 % at 0-10 deg)")
+      ->check(CLI::Range(0.001, 0.5));
   cli.app().add_option("--methods", methods, "Deterministic methods (default: every registered one)")->delimiter(',');
   cli.app()
       .add_option("--qualities", qualities, "Qualities of the deterministic methods (default: low,medium,high)")
@@ -186,7 +196,7 @@ int main(int argc, char** argv) {
       // References first (the expensive part), so the methods compare against them.
       std::vector<PathResult> ref;
       for (double elev : elevations) {
-        const PathTracerSettings ps = ReferenceSettings(elev);
+        const PathTracerSettings ps = ReferenceSettings(elev, reference_error);
         const auto t0 = Clock::now();
         ref.push_back(PathSky(scene, D, (90.0 - elev) * kPi / 180.0, ps, fs::path(out_dir) / "references",
                               fmt::format("{}_elev{:+03.0f}", atm, elev), key_text));
@@ -255,7 +265,7 @@ int main(int argc, char** argv) {
           PathTracerSettings ps;
           ps.target_relative_error = target;
           ps.seed = 7;  // independent of the reference's streams
-          if (target <= ReferenceSettings(elevations[e]).target_relative_error) continue;
+          if (target <= ReferenceSettings(elevations[e], reference_error).target_relative_error) continue;
           const PathResult r = PathSky(scene, D, (90.0 - elevations[e]) * kPi / 180.0, ps, fs::path(out_dir) / "references",
                                        fmt::format("{}_elev{:+03.0f}_path{}", atm, elevations[e], quality), key_text);
           record(elevations[e], e, "path", quality, "", 0.0, r.cpu_s, r.xyz);

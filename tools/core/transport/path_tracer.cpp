@@ -124,14 +124,46 @@ PathTracer::PathTracer(const AtmosphereModel& model, std::vector<std::array<doub
   for (size_t s = 0; s < shells_.size(); ++s) {
     for (size_t w = 0; w < nw; ++w) shell_majorant_[s * nw + w] = model_.MaxExtinction(shells_[s].level_lo, shells_[s].level_hi, w);
   }
-  double peak = 0.0;  // P_max, sr^-1: every phase model here peaks forward or backward
-  for (const MediumComponent& c : model_.components) {
-    if (!c.phase || *std::max_element(c.scattering.begin(), c.scattering.end()) <= 0.0) continue;
-    for (size_t w = 0; w < nw; ++w) peak = std::max({peak, c.phase->Eval(w, 1.0), c.phase->Eval(w, -1.0)});
+  // P_max (sr^-1) of each scattering component (every phase model here peaks forward or
+  // backward) and of them all.
+  const size_t nc = model_.components.size();
+  std::vector<double> component_peak(nc, 0.0);
+  for (size_t c = 0; c < nc; ++c) {
+    const MediumComponent& comp = model_.components[c];
+    if (!comp.phase || *std::max_element(comp.scattering.begin(), comp.scattering.end()) <= 0.0) continue;
+    for (size_t w = 0; w < nw; ++w) {
+      component_peak[c] = std::max({component_peak[c], comp.phase->Eval(w, 1.0), comp.phase->Eval(w, -1.0)});
+    }
   }
+  const double peak = *std::max_element(component_peak.begin(), component_peak.end());
+  // The sun-peak guide's mixture: the components whose peak exceeds sun_peak_min, each by its
+  // share of their column scattering optical depth (trapezoid over the levels) per wavelength.
+  // Without such a component the guide is off.
+  peak_guide_ = settings_.sun_peak_guide;
+  peak_weight_.assign(nw * nc, 0.0);
+  for (size_t w = 0; w < nw; ++w) {
+    double sum = 0.0;
+    for (size_t c = 0; c < nc; ++c) {
+      const MediumComponent& comp = model_.components[c];
+      if (component_peak[c] <= settings_.sun_peak_min) continue;
+      double tau = 0.0;
+      for (size_t l = 0; l + 1 < model_.levels(); ++l) {
+        tau += 0.5 * (comp.scattering[l * nw + w] + comp.scattering[(l + 1) * nw + w]) * (z[l + 1] - z[l]);
+      }
+      peak_weight_[w * nc + c] = tau;
+      sum += tau;
+    }
+    for (size_t c = 0; c < nc; ++c) peak_weight_[w * nc + c] = sum > 0.0 ? peak_weight_[w * nc + c] / sum : 0.0;
+    // A wavelength on which the peaked components do not scatter at all leaves the guide off.
+    if (!(sum > 0.0)) peak_guide_ = 0.0;
+  }
+  cloud_estimators_ = peak > settings_.sun_peak_min && settings_.illumination == Illumination::kSun;
+  if (!cloud_estimators_) peak_guide_ = 0.0;
   shadow_radius_m_ = model_.bottom_radius_m -
                      (model_.sun.angular_radius_rad * DistanceToHorizon(model_.top_radius_m, model_.bottom_radius_m) + 1.0);
-  const double min_paths = std::ceil(settings_.rare_peak_events * 4.0 * kPi * peak);
+  double min_paths = std::ceil(settings_.rare_peak_events * 4.0 * kPi * peak);
+  if (peak_guide_ > 0.0) min_paths = std::min(min_paths, static_cast<double>(settings_.guided_peak_paths));
+  split_above_ = cloud_estimators_ ? settings_.split_above : 0.0;
   peak_min_paths_ = min_paths >= static_cast<double>(settings_.max_paths) ? settings_.max_paths : static_cast<uint64_t>(min_paths);
 }
 
@@ -164,6 +196,34 @@ double PathTracer::MixturePhase(const AtmosphereModel::Cell& cell, size_t wl, do
     den += s;
   }
   return den > 0.0 ? num / den : 0.0;
+}
+
+glm::dvec3 PathTracer::SamplePeakAboutSun(size_t wl, const glm::dvec3& sun, Pcg32& rng) const {
+  const size_t nc = model_.components.size();
+  double u = rng.Uniform();
+  size_t chosen = nc;
+  for (size_t c = 0; c < nc; ++c) {
+    const double w = peak_weight_[wl * nc + c];
+    if (w <= 0.0) continue;
+    chosen = c;
+    if (u < w) break;
+    u -= w;
+  }
+  SKYBAKE_CHECK_LT(chosen, nc);
+  return RotateAround(sun, model_.components[chosen].phase->SampleMu(wl, rng.Uniform()), 2.0 * kPi * rng.Uniform());
+}
+
+double PathTracer::PeakAboutSunPdf(const size_t* idx, int nh, double cos_to_sun) const {
+  const size_t nc = model_.components.size();
+  const double mu = std::clamp(cos_to_sun, -1.0, 1.0);
+  double pdf = 0.0;
+  for (int h = 0; h < nh; ++h) {
+    for (size_t c = 0; c < nc; ++c) {
+      const double w = peak_weight_[idx[h] * nc + c];
+      if (w > 0.0) pdf += w * model_.components[c].phase->Eval(idx[h], mu);
+    }
+  }
+  return pdf / nh;
 }
 
 void PathTracer::Transmittance(const glm::dvec3& position, const glm::dvec3& direction, const size_t* idx, int k,
@@ -260,7 +320,7 @@ void PathTracer::SunNee(const glm::dvec3& x, const glm::dvec3& d, bool ground, c
 
 
 void PathTracer::SegmentSunNee(const glm::dvec3& p, const glm::dvec3& d, const double* beta, const size_t* idx, int k,
-                               const glm::dvec3& sun, Pcg32& rng, double* L, double t_cap) const {
+                               const glm::dvec3& sun, Pcg32& rng, double* L, double t_cap, double nee_floor_y) const {
   const double R = model_.bottom_radius_m, top = model_.top_radius_m;
   const SphereHit g = NearSphere(p, d, R);
   const double t_end = std::min(t_cap, g.hit ? g.t : FarSphere(p, d, top));
@@ -339,7 +399,9 @@ void PathTracer::SegmentSunNee(const glm::dvec3& p, const glm::dvec3& d, const d
     double sun_factor = 1.0;
     if (sun_depth) {
       double tau_min = SunDepthTable::kMaxDepth;
-      for (int j = 0; j < k; ++j) tau_min = std::min(tau_min, sun_depth->Depth(rx, mu_sun, idx[j]));
+      double depths[kMaxWavelengths];
+      sun_depth->Depths(rx, mu_sun, idx, k, depths);
+      for (int j = 0; j < k; ++j) tau_min = std::min(tau_min, depths[j]);
       sun_factor = std::exp(-tau_min);
     }
     for (int hh = 0; hh < nh; ++hh) {
@@ -382,8 +444,8 @@ void PathTracer::SegmentSunNee(const glm::dvec3& p, const glm::dvec3& d, const d
         const double a = w0[hh], b = w_at[hh];
         double mass;
         if (a > 0.0 && b > 0.0) {
-          const double beta = std::log(b / a);
-          mass = std::abs(beta) > 1e-9 ? h * (b - a) / beta : h * a;
+          const double slope = std::log(b / a);
+          mass = std::abs(slope) > 1e-9 ? h * (b - a) / slope : h * a;
         } else {
           mass = 0.5 * (a + b) * h;
         }
@@ -422,15 +484,15 @@ void PathTracer::SegmentSunNee(const glm::dvec3& p, const glm::dvec3& d, const d
     return a > 0.0 && b > 0.0 ? std::log(b / a) : std::numeric_limits<double>::quiet_NaN();
   };
   auto density = [&](int hh, double f) {
-    const double beta = log_linear(hh);
-    if (std::isnan(beta)) return piece_mass[hh][chosen] / (piece_len[chosen] * total[hh]);
-    return piece_w0[hh][chosen] * std::exp(beta * f) / total[hh];
+    const double slope = log_linear(hh);
+    if (std::isnan(slope)) return piece_mass[hh][chosen] / (piece_len[chosen] * total[hh]);
+    return piece_w0[hh][chosen] * std::exp(slope * f) / total[hh];
   };
   const double u2 = rng.Uniform();
   double frac = u2;
   {
-    const double beta = log_linear(tech);
-    if (!std::isnan(beta) && std::abs(beta) > 1e-9) frac = std::clamp(std::log1p(u2 * std::expm1(beta)) / beta, 0.0, 1.0);
+    const double slope = log_linear(tech);
+    if (!std::isnan(slope) && std::abs(slope) > 1e-9) frac = std::clamp(std::log1p(u2 * std::expm1(slope)) / slope, 0.0, 1.0);
   }
   const double t_star = piece_lo[chosen] + frac * piece_len[chosen];
   double pdf = 0.0;
@@ -464,19 +526,33 @@ void PathTracer::SegmentSunNee(const glm::dvec3& p, const glm::dvec3& d, const d
   }
   if (sun_depth) {
     const double rx = glm::length(x), mu_sun = glm::dot(x, sun) / rx;
+    double depths[kMaxWavelengths];
+    sun_depth->Depths(rx, mu_sun, idx, k, depths);
     for (int j = 0; j < k; ++j) {
-      const double t = sun_depth->Depth(rx, mu_sun, idx[j]);
+      const double t = depths[j];
       sun_min = std::min(sun_min, t);
       sun_max = std::max(sun_max, t);
     }
   } else {
     sun_min = 0.0;
   }
+  const double omega = sm.SolidAngle();
+  // Russian roulette on a connection whose expected Y (the transmittances taken as the expected
+  // depths' e^-tau) is below nee_floor_y: survivors are divided by the survival probability.
+  if (nee_floor_y > 0.0) {
+    double expected = 0.0;
+    for (int j = 0; j < k; ++j) expected += xyz_weights_[idx[j]][1] * f[j] * sm.Radiance(idx[j], alpha);
+    expected *= omega / pdf * std::exp(-(view_min + sun_min)) * static_cast<double>(model_.wavelengths()) / k;
+    if (expected < nee_floor_y) {
+      const double q = expected / nee_floor_y;
+      if (!(q > 0.0) || rng.Uniform() >= q) return;
+      for (int j = 0; j < k; ++j) f[j] /= q;
+    }
+  }
   double t_view[kMaxWavelengths], t_sun[kMaxWavelengths];
   TransmittanceAlong(p, d, t_star, idx, k, rng, t_view, 1e-3 * std::exp(-view_min), std::clamp(view_max, 1.0, kMaxMajorantScale));
   TransmittanceAlong(x, wl, std::numeric_limits<double>::infinity(), idx, k, rng, t_sun, 1e-3 * std::exp(-sun_min),
                      std::clamp(sun_max, 1.0, kMaxMajorantScale));
-  const double omega = sm.SolidAngle();
   for (int j = 0; j < k; ++j) L[j] += f[j] * t_view[j] * t_sun[j] * sm.Radiance(idx[j], alpha) * omega / pdf;
 }
 
@@ -502,188 +578,254 @@ struct FirstOrderCapture {
 };
 }  // namespace
 
-void PathTracer::TracePath(glm::dvec3 p, glm::dvec3 d, const glm::dvec3& sun, const size_t* idx, int k, Pcg32& rng,
-                           double* L, double view_t_end, bool single_scattering, double* L1) const {
+// One path and the branches split from it (the estimator: path_tracer.h). It takes a page because
+// the free flight, the three kinds of event (escape, ground, scattering) and the roulette and
+// splitting after each all read and write the branch's state (position, direction, shell,
+// weights, order), and splitting them into functions would pass that state around per event.
+void PathTracer::TracePath(glm::dvec3 start, glm::dvec3 direction, const glm::dvec3& sun, const size_t* idx, int k,
+                           Pcg32& rng, double* L, double view_t_end, bool single_scattering, double* L1,
+                           double nee_floor_y) const {
   // Segment mode (view_t_end finite): the first flight ends at view_t_end, the path dies there
   // and at the ground (no surface term); later flights are unrestricted.
   const bool segment = std::isfinite(view_t_end);
   double travelled = 0.0;
-  double beta[kMaxWavelengths];
-  for (int j = 0; j < k; ++j) {
-    beta[j] = 1.0;
-    L[j] = 0.0;
-  }
+  for (int j = 0; j < k; ++j) L[j] = 0.0;
   const bool sun_mode = settings_.illumination == Illumination::kSun;
   const bool segment_nee = sun_mode && settings_.segment_nee;
   const int max_order = settings_.max_order > 0 ? settings_.max_order : std::numeric_limits<int>::max();
-  size_t s = ShellOf(glm::length(p));
   FirstOrderCapture first{L1, L, k};
-  // `depth` = scattering and reflection events so far; a sun connection made now is of order
-  // depth + 1.
-  for (int depth = 0; depth < 100000; ++depth) {
-    if (depth == 1) first.Take();
-    // Order-1 sun connections are skipped when single scattering is excluded (shadowed fog).
-    const bool nee_here = depth + 1 <= max_order && (single_scattering || depth > 0);
-    if (segment_nee && nee_here) {
-      SegmentSunNee(p, d, beta, idx, k, sun, rng, L,
-                    segment && depth == 0 ? view_t_end : std::numeric_limits<double>::infinity());
-    }
-    // ---- free flight to the next real scattering event, the ground, or space
-    enum class Event { kScatter, kGround, kEscape } event = Event::kEscape;
-    for (int guard = 0;; ++guard) {
-      if (guard > 1000000) throw InternalError("free-flight traversal did not terminate");
-      const Shell& sh = shells_[s];
-      SphereHit inner = NearSphere(p, d, sh.radius_lo);
-      const bool down = inner.hit;
-      const double t_exit = down ? inner.t : FarSphere(p, d, sh.radius_hi);
-      const double mu_bar = Majorant(s, idx, k);
-      // What is left of the view segment from this shell's entry point.
-      const double t_limit =
-          segment && depth == 0 ? view_t_end - travelled : std::numeric_limits<double>::infinity();
-      double t = 0.0;
-      bool scattered = false;
-      if (mu_bar > 0.0) {
-        for (;;) {
-          t -= std::log(1.0 - rng.Uniform()) / mu_bar;
-          if (t >= t_limit && t_limit <= t_exit) return;  // beyond the view segment
-          if (t >= t_exit) break;
-          const glm::dvec3 x = p + t * d;
-          const AtmosphereModel::Cell cell = model_.Locate(glm::length(x) - model_.bottom_radius_m);
-          double ms[kMaxWavelengths], mn[kMaxWavelengths];
-          double ps = 0.0, pn = 0.0;
-          for (int j = 0; j < k; ++j) {
-            ms[j] = model_.Scattering(cell, idx[j]);
-            mn[j] = std::max(0.0, mu_bar - model_.Extinction(cell, idx[j]));
-            ps += std::abs(beta[j] * ms[j]);
-            pn += std::abs(beta[j] * mn[j]);
+  // Branches split off the path (split_above, in a cloudy atmosphere) wait here; each continues
+  // from its vertex with its share of the weight after the branch before it has ended, drawing
+  // from the same stream (the same numbers at any thread count).
+  struct Branch {
+    glm::dvec3 p, d;
+    size_t shell;
+    int depth;
+    double beta[kMaxWavelengths];
+  };
+  constexpr int kMaxBranches = 64;
+  Branch waiting[kMaxBranches];
+  int n_waiting = 0;
+  Branch first_branch{start, direction, ShellOf(glm::length(start)), 0, {}};
+  for (int j = 0; j < k; ++j) first_branch.beta[j] = 1.0;
+  // One branch from its vertex until it ends (a `return` ends the branch, not the path).
+  auto run_branch = [&](const Branch& from) {
+    glm::dvec3 p = from.p, d = from.d;
+    size_t s = from.shell;
+    double beta[kMaxWavelengths];
+    for (int j = 0; j < k; ++j) beta[j] = from.beta[j];
+    // `depth` = scattering and reflection events so far; a sun connection made now is of order
+    // depth + 1.
+    for (int depth = from.depth; depth < 100000; ++depth) {
+      if (depth == 1) first.Take();
+      double importance = 1.0;  // of the direction the branch leaves the next vertex in
+      // Order-1 sun connections are skipped when single scattering is excluded (shadowed fog).
+      const bool nee_here = depth + 1 <= max_order && (single_scattering || depth > 0);
+      if (segment_nee && nee_here) {
+        SegmentSunNee(p, d, beta, idx, k, sun, rng, L,
+                      segment && depth == 0 ? view_t_end : std::numeric_limits<double>::infinity(), nee_floor_y);
+      }
+      // ---- free flight to the next real scattering event, the ground, or space
+      enum class Event { kScatter, kGround, kEscape } event = Event::kEscape;
+      for (int guard = 0;; ++guard) {
+        if (guard > 1000000) throw InternalError("free-flight traversal did not terminate");
+        const Shell& sh = shells_[s];
+        SphereHit inner = NearSphere(p, d, sh.radius_lo);
+        const bool down = inner.hit;
+        const double t_exit = down ? inner.t : FarSphere(p, d, sh.radius_hi);
+        const double mu_bar = Majorant(s, idx, k);
+        // What is left of the view segment from this shell's entry point.
+        const double t_limit =
+            segment && depth == 0 ? view_t_end - travelled : std::numeric_limits<double>::infinity();
+        double t = 0.0;
+        bool scattered = false;
+        if (mu_bar > 0.0) {
+          for (;;) {
+            t -= std::log(1.0 - rng.Uniform()) / mu_bar;
+            if (t >= t_limit && t_limit <= t_exit) return;  // beyond the view segment
+            if (t >= t_exit) break;
+            const glm::dvec3 x = p + t * d;
+            const AtmosphereModel::Cell cell = model_.Locate(glm::length(x) - model_.bottom_radius_m);
+            double ms[kMaxWavelengths], mn[kMaxWavelengths];
+            double ps = 0.0, pn = 0.0;
+            for (int j = 0; j < k; ++j) {
+              ms[j] = model_.Scattering(cell, idx[j]);
+              mn[j] = std::max(0.0, mu_bar - model_.Extinction(cell, idx[j]));
+              ps += std::abs(beta[j] * ms[j]);
+              pn += std::abs(beta[j] * mn[j]);
+            }
+            if (ps + pn <= 0.0) return;  // every weight is zero
+            const double P_s = ps / (ps + pn);
+            if (rng.Uniform() < P_s) {
+              for (int j = 0; j < k; ++j) beta[j] *= ms[j] / (mu_bar * P_s);
+              p = x;
+              scattered = true;
+              break;
+            }
+            for (int j = 0; j < k; ++j) beta[j] *= mn[j] / (mu_bar * (1.0 - P_s));
           }
-          if (ps + pn <= 0.0) return;  // every weight is zero
-          const double P_s = ps / (ps + pn);
-          if (rng.Uniform() < P_s) {
-            for (int j = 0; j < k; ++j) beta[j] *= ms[j] / (mu_bar * P_s);
-            p = x;
-            scattered = true;
+        }
+        if (scattered) {
+          event = Event::kScatter;
+          break;
+        }
+        p += t_exit * d;
+        if (segment && depth == 0) {
+          travelled += t_exit;
+          if (t_exit >= t_limit) return;  // the segment ends inside this shell
+        }
+        if (down) {
+          if (s == 0) {
+            event = Event::kGround;
+            // Snap exactly onto the ground sphere.
+            p = glm::normalize(p) * model_.bottom_radius_m;
             break;
           }
-          for (int j = 0; j < k; ++j) beta[j] *= mn[j] / (mu_bar * (1.0 - P_s));
+          --s;
+        } else {
+          if (s + 1 == shells_.size()) {
+            event = Event::kEscape;
+            break;
+          }
+          ++s;
         }
       }
-      if (scattered) {
-        event = Event::kScatter;
-        break;
-      }
-      p += t_exit * d;
-      if (segment && depth == 0) {
-        travelled += t_exit;
-        if (t_exit >= t_limit) return;  // the segment ends inside this shell
-      }
-      if (down) {
-        if (s == 0) {
-          event = Event::kGround;
-          // Snap exactly onto the ground sphere.
-          p = glm::normalize(p) * model_.bottom_radius_m;
-          break;
-        }
-        --s;
-      } else {
-        if (s + 1 == shells_.size()) {
-          event = Event::kEscape;
-          break;
-        }
-        ++s;
-      }
-    }
 
-    if (event == Event::kEscape) {
-      if (depth == 0) first.Take();  // the unscattered light from space (uniform mode) is order 0
-      if (!sun_mode && depth <= max_order) {
-        for (int j = 0; j < k; ++j) L[j] += beta[j];  // uniform radiance 1 from space
+      if (event == Event::kEscape) {
+        if (depth == 0) first.Take();  // the unscattered light from space (uniform mode) is order 0
+        if (!sun_mode && depth <= max_order) {
+          for (int j = 0; j < k; ++j) L[j] += beta[j];  // uniform radiance 1 from space
+        }
+        return;
       }
-      return;
-    }
 
-    if (event == Event::kGround) {
-      if (segment && depth == 0) return;  // fog: the surface is not part of a view segment
-      const glm::dvec3 n = glm::normalize(p);
-      if (sun_mode && nee_here) SunNee(p, d, true, beta, idx, k, sun, rng, L);
-      if (depth + 1 >= max_order && sun_mode) return;
-      // Cosine-weighted bounce: f cos / pdf = albedo.
-      double bmax = 0.0;
-      for (int j = 0; j < k; ++j) {
-        beta[j] *= model_.ground_albedo[idx[j]];
-        bmax = std::max(bmax, beta[j]);
-      }
-      if (bmax <= 0.0) return;
-      d = CosineHemisphere(n, rng.Uniform(), rng.Uniform());
-      p += n * 1e-3;  // leave the surface
-      s = 0;
-    } else {
-      // Medium scattering vertex.
-      if (sun_mode && !segment_nee && nee_here) SunNee(p, d, false, beta, idx, k, sun, rng, L);
-      if (depth + 1 >= max_order && sun_mode) return;
-      const AtmosphereModel::Cell cell = model_.Locate(glm::length(p) - model_.bottom_radius_m);
-      // Component choice ~ sum_j |b_j| mu_s,c(lambda_j); direction from that component's phase
-      // at the hero wavelength; weight by each wavelength's mixture phase / mixture pdf.
-      const size_t nc = model_.components.size();
-      double sel[32];
-      SKYBAKE_CHECK_LE(nc, size_t{32});
-      double total = 0.0;
-      for (size_t c = 0; c < nc; ++c) {
-        sel[c] = 0.0;
-        if (!model_.components[c].phase) continue;
-        for (int j = 0; j < k; ++j) sel[c] += std::abs(beta[j]) * model_.ComponentScattering(c, cell, idx[j]);
-        total += sel[c];
-      }
-      if (total <= 0.0) return;
-      double u = rng.Uniform() * total;
-      size_t chosen = 0;
-      for (size_t c = 0; c < nc; ++c) {
-        if (sel[c] <= 0.0) continue;
-        chosen = c;
-        if (u < sel[c]) break;
-        u -= sel[c];
-      }
-      // The technique wavelength: the hero, or (wavelength_mis) one of the k drawn uniformly,
-      // the pdf then the mixture over the k (one-sample MIS).
-      const int nh = settings_.wavelength_mis ? k : 1;
-      const int tech = nh > 1 ? std::min(nh - 1, static_cast<int>(rng.Uniform() * nh)) : 0;
-      // In the Earth's shadow (twilight_guide): half of the directions from the sunward band.
-      glm::dvec3 bn, bg, bb;
-      const bool guide = settings_.twilight_guide && sun_mode && segment_nee && InEarthShadow(p, sun) &&
-                         BandFrame(p, sun, &bn, &bg, &bb);
-      glm::dvec3 d_new;
-      double mu;
-      if (guide && rng.Uniform() < 0.5) {
-        d_new = SampleBand(bn, bg, bb, rng.Uniform(), rng.Uniform());
-        mu = std::clamp(glm::dot(d, d_new), -1.0, 1.0);
+      if (event == Event::kGround) {
+        if (segment && depth == 0) return;  // fog: the surface is not part of a view segment
+        const glm::dvec3 n = glm::normalize(p);
+        if (sun_mode && nee_here) SunNee(p, d, true, beta, idx, k, sun, rng, L);
+        if (depth + 1 >= max_order && sun_mode) return;
+        // Cosine-weighted bounce: f cos / pdf = albedo; where the sun is not hidden (sun_peak_guide)
+        // a share of the directions about the sun, f cos / pdf = albedo x (cos / pi) / the mixture.
+        double bmax = 0.0;
+        for (int j = 0; j < k; ++j) {
+          beta[j] *= model_.ground_albedo[idx[j]];
+          bmax = std::max(bmax, beta[j]);
+        }
+        if (bmax <= 0.0) return;
+        const double q_sun = sun_mode && segment_nee && !InEarthShadow(p, sun) ? peak_guide_ : 0.0;
+        if (q_sun > 0.0) {
+          const int nh = settings_.wavelength_mis ? k : 1;
+          const int tech = nh > 1 ? std::min(nh - 1, static_cast<int>(rng.Uniform() * nh)) : 0;
+          d = rng.Uniform() < q_sun ? SamplePeakAboutSun(idx[tech], sun, rng) : CosineHemisphere(n, rng.Uniform(), rng.Uniform());
+          const double cos_n = glm::dot(n, d);
+          if (cos_n <= 0.0) return;  // a direction about the sun below the ground's horizon
+          const double peak = PeakAboutSunPdf(idx, nh, glm::dot(sun, d));
+          const double ratio = cos_n / kPi / ((1.0 - q_sun) * cos_n / kPi + q_sun * peak);
+          for (int j = 0; j < k; ++j) beta[j] *= ratio;
+          importance = std::max(1.0, q_sun * peak);
+        } else {
+          d = CosineHemisphere(n, rng.Uniform(), rng.Uniform());
+        }
+        p += n * 1e-3;  // leave the surface
+        s = 0;
       } else {
-        mu = model_.components[chosen].phase->SampleMu(idx[tech], rng.Uniform());
-        d_new = RotateAround(d, mu, 2.0 * kPi * rng.Uniform());
-      }
-      // Mixture pdf (solid angle) of the sampled direction.
-      double pdf = 0.0;
-      for (int h = 0; h < nh; ++h) {
-        double ph = 0.0;
+        // Medium scattering vertex.
+        if (sun_mode && !segment_nee && nee_here) SunNee(p, d, false, beta, idx, k, sun, rng, L);
+        if (depth + 1 >= max_order && sun_mode) return;
+        const AtmosphereModel::Cell cell = model_.Locate(glm::length(p) - model_.bottom_radius_m);
+        // Component choice ~ sum_j |b_j| mu_s,c(lambda_j); direction from that component's phase
+        // at the hero wavelength; weight by each wavelength's mixture phase / mixture pdf.
+        const size_t nc = model_.components.size();
+        double sel[32];
+        SKYBAKE_CHECK_LE(nc, size_t{32});
+        double total = 0.0;
         for (size_t c = 0; c < nc; ++c) {
-          if (sel[c] > 0.0) ph += sel[c] / total * model_.components[c].phase->Eval(idx[h], mu);
+          sel[c] = 0.0;
+          if (!model_.components[c].phase) continue;
+          for (int j = 0; j < k; ++j) sel[c] += std::abs(beta[j]) * model_.ComponentScattering(c, cell, idx[j]);
+          total += sel[c];
         }
-        pdf += ph;
+        if (total <= 0.0) return;
+        double u = rng.Uniform() * total;
+        size_t chosen = 0;
+        for (size_t c = 0; c < nc; ++c) {
+          if (sel[c] <= 0.0) continue;
+          chosen = c;
+          if (u < sel[c]) break;
+          u -= sel[c];
+        }
+        // The technique wavelength: the hero, or (wavelength_mis) one of the k drawn uniformly,
+        // the pdf then the mixture over the k (one-sample MIS).
+        const int nh = settings_.wavelength_mis ? k : 1;
+        const int tech = nh > 1 ? std::min(nh - 1, static_cast<int>(rng.Uniform() * nh)) : 0;
+        // The vertex's techniques: in the Earth's shadow (twilight_guide) half of the directions
+        // from the sunward band; where the sun is not hidden by the planet (sun_peak_guide) a share
+        // from the phase function centred on the sun; the rest from the phase function about d.
+        glm::dvec3 bn(0.0), bg(0.0), bb(0.0);
+        const bool shadowed = sun_mode && segment_nee && InEarthShadow(p, sun);
+        const bool guide = settings_.twilight_guide && shadowed && BandFrame(p, sun, &bn, &bg, &bb);
+        const double q_band = guide ? 0.5 : 0.0;
+        const double q_sun = sun_mode && segment_nee && !shadowed ? peak_guide_ : 0.0;
+        glm::dvec3 d_new;
+        double mu;
+        const double u_tech = q_band + q_sun > 0.0 ? rng.Uniform() : 1.0;
+        if (u_tech < q_band + q_sun) {
+          d_new = u_tech < q_band ? SampleBand(bn, bg, bb, rng.Uniform(), rng.Uniform())
+                                  : SamplePeakAboutSun(idx[tech], sun, rng);
+          mu = std::clamp(glm::dot(d, d_new), -1.0, 1.0);
+        } else {
+          mu = model_.components[chosen].phase->SampleMu(idx[tech], rng.Uniform());
+          d_new = RotateAround(d, mu, 2.0 * kPi * rng.Uniform());
+        }
+        // Mixture pdf (solid angle) of the sampled direction: the component mixture's phase at the
+        // technique wavelengths about d, and (q_sun) the peak about the sun.
+        auto mixture_pdf = [&](double cos_angle) {
+          double pm = 0.0;
+          for (int h = 0; h < nh; ++h) {
+            for (size_t c = 0; c < nc; ++c) {
+              if (sel[c] > 0.0) pm += sel[c] / total * model_.components[c].phase->Eval(idx[h], cos_angle);
+            }
+          }
+          return pm / nh;
+        };
+        double pdf = (1.0 - q_band - q_sun) * mixture_pdf(mu);
+        const double peak = q_sun > 0.0 ? PeakAboutSunPdf(idx, nh, glm::dot(sun, d_new)) : 0.0;
+        pdf += q_sun * peak;
+        if (q_band > 0.0) pdf += q_band * BandPdf(d_new, bn, bg, bb);
+        if (!(pdf > 0.0)) return;
+        for (int j = 0; j < k; ++j) beta[j] *= MixturePhase(cell, idx[j], mu) / pdf;
+        if (q_sun > 0.0) importance = std::max(1.0, q_sun * peak);
+        d = d_new;  // the vertex is inside shell s: the traversal continues from there
       }
-      pdf /= nh;
-      if (guide) pdf = 0.5 * pdf + 0.5 * BandPdf(d_new, bn, bg, bb);
-      if (!(pdf > 0.0)) return;
-      for (int j = 0; j < k; ++j) beta[j] *= MixturePhase(cell, idx[j], mu) / pdf;
-      d = d_new;  // the vertex is inside shell s: the traversal continues from there
-    }
 
-    // Russian roulette.
-    if (depth + 1 >= settings_.russian_roulette_depth) {
+      // Russian roulette and splitting on the weight times the direction's importance (1, or
+      // q_sun x the phase towards the sun where the vertex guides towards the sun's peak).
       double bmax = 0.0;
       for (int j = 0; j < k; ++j) bmax = std::max(bmax, std::abs(beta[j]));
-      const double q = std::min(1.0, bmax);
-      if (q <= 0.0 || rng.Uniform() >= q) return;
-      for (int j = 0; j < k; ++j) beta[j] /= q;
+      const double e = bmax * importance;
+      if (depth + 1 >= settings_.russian_roulette_depth) {
+        const double q = std::min(1.0, e);
+        if (q <= 0.0 || rng.Uniform() >= q) return;
+        for (int j = 0; j < k; ++j) beta[j] /= q;
+      }
+      if (split_above_ > 0.0 && e > split_above_ && n_waiting < kMaxBranches) {
+        const int n = std::min(kMaxBranches - n_waiting + 1, static_cast<int>(std::ceil(e)));
+        for (int j = 0; j < k; ++j) beta[j] /= n;
+        for (int i = 1; i < n; ++i) {
+          Branch& w = waiting[n_waiting++];
+          w.p = p;
+          w.d = d;
+          w.shell = s;
+          w.depth = depth + 1;
+          for (int j = 0; j < k; ++j) w.beta[j] = beta[j];
+        }
+      }
     }
+  };
+  run_branch(first_branch);
+  while (n_waiting > 0) {
+    --n_waiting;
+    run_branch(waiting[n_waiting]);
   }
 }
 
@@ -694,7 +836,7 @@ glm::dvec3 PathTracer::StartPoint(const glm::dvec3& position) const {
 
 void PathTracer::SamplePath(const glm::dvec3& position, const glm::dvec3& direction, const glm::dvec3& sun_direction,
                             uint64_t stream, uint64_t n, bool cosine_hemisphere, double view_t_end,
-                            bool single_scattering, double* xyz) const {
+                            bool single_scattering, double* xyz, double nee_floor_y) const {
   const glm::dvec3 start = StartPoint(position);
   const size_t n_wl = model_.wavelengths();
   const int k = static_cast<int>(std::min<size_t>(static_cast<size_t>(settings_.wavelengths_per_path), n_wl));
@@ -710,7 +852,7 @@ void PathTracer::SamplePath(const glm::dvec3& position, const glm::dvec3& direct
     weight = kPi;  // E = pi E_cos[L]
   }
   double L[kMaxWavelengths];
-  TracePath(start, d, sun_direction, idx, k, rng, L, view_t_end, single_scattering);
+  TracePath(start, d, sun_direction, idx, k, rng, L, view_t_end, single_scattering, nullptr, nee_floor_y / weight);
   for (int c = 0; c < 3; ++c) xyz[c] = 0.0;
   for (int j = 0; j < k; ++j) {
     for (int c = 0; c < 3; ++c) xyz[c] += scale * weight * xyz_weights_[idx[j]][static_cast<size_t>(c)] * L[j];
@@ -718,8 +860,9 @@ void PathTracer::SamplePath(const glm::dvec3& position, const glm::dvec3& direct
 }
 
 void PathTracer::ColorPath(const glm::dvec3& position, const glm::dvec3& direction, const glm::dvec3& sun_direction,
-                           uint64_t stream, uint64_t n, double* xyz) const {
-  SamplePath(position, direction, sun_direction, stream, n, false, std::numeric_limits<double>::infinity(), true, xyz);
+                           uint64_t stream, uint64_t n, double* xyz, double nee_floor_y) const {
+  SamplePath(position, direction, sun_direction, stream, n, false, std::numeric_limits<double>::infinity(), true, xyz,
+             nee_floor_y);
 }
 
 ColorEstimate PathTracer::Estimate(const glm::dvec3& position, const glm::dvec3& direction,
@@ -727,12 +870,15 @@ ColorEstimate PathTracer::Estimate(const glm::dvec3& position, const glm::dvec3&
                                    double view_t_end, bool single_scattering) const {
   RunningMoments acc[3];  // X, Y, Z
   uint64_t n = 0;
+  double floor_y = 0.0;  // nee_roulette x the estimate of the batches so far
   for (;;) {
     for (uint64_t b = 0; b < settings_.batch_paths; ++b, ++n) {
       double xyz[3];
-      SamplePath(position, direction, sun_direction, stream, n, cosine_hemisphere, view_t_end, single_scattering, xyz);
+      SamplePath(position, direction, sun_direction, stream, n, cosine_hemisphere, view_t_end, single_scattering, xyz,
+                 floor_y);
       for (int c = 0; c < 3; ++c) acc[c].Add(xyz[c]);
     }
+    if (cloud_estimators_) floor_y = settings_.nee_roulette * std::abs(acc[1].mean);
     if (n >= MinPaths()) {
       const RunningMoments& y = acc[1];
       // An all-zero start (e.g. a view into the Earth's shadow) is not a converged estimate:

@@ -52,6 +52,12 @@ SunDepthTable::SunDepthTable(const AtmosphereModel& m, int altitudes, int cosine
 }
 
 double SunDepthTable::Depth(double r, double mu, size_t w) const {
+  double out;
+  Depths(r, mu, &w, 1, &out);
+  return out;
+}
+
+void SunDepthTable::Depths(double r, double mu, const size_t* w, int k, double* out) const {
   const double H = top_ - bottom_;
   const double a = std::sqrt(std::clamp((r - bottom_) / H, 0.0, 1.0)) * (na_ - 1);
   const int i0 = std::min(na_ - 2, static_cast<int>(a));
@@ -62,10 +68,15 @@ double SunDepthTable::Depth(double r, double mu, size_t w) const {
   const double b = std::sqrt(x) * (nm_ - 1);
   const int j0 = std::min(nm_ - 2, static_cast<int>(b));
   const double fb = b - j0;
-  auto at = [&](int i, int j) {
-    return static_cast<double>(depth_[(static_cast<size_t>(i) * static_cast<size_t>(nm_) + static_cast<size_t>(j)) * nw_ + w]);
-  };
-  return (1 - fa) * ((1 - fb) * at(i0, j0) + fb * at(i0, j0 + 1)) + fa * ((1 - fb) * at(i0 + 1, j0) + fb * at(i0 + 1, j0 + 1));
+  const float* row00 = &depth_[(static_cast<size_t>(i0) * static_cast<size_t>(nm_) + static_cast<size_t>(j0)) * nw_];
+  const float* row01 = row00 + nw_;
+  const float* row10 = row00 + static_cast<size_t>(nm_) * nw_;
+  const float* row11 = row10 + nw_;
+  for (int q = 0; q < k; ++q) {
+    const size_t v = w[q];
+    out[q] = (1 - fa) * ((1 - fb) * static_cast<double>(row00[v]) + fb * static_cast<double>(row01[v])) +
+             fa * ((1 - fb) * static_cast<double>(row10[v]) + fb * static_cast<double>(row11[v]));
+  }
 }
 
 }  // namespace skybake

@@ -31,6 +31,8 @@ class SunDepthTable {
   // Optical depth (dimensionless) at radius r (m, planet-centred) towards a direction of cosine
   // mu with the local vertical, for grid wavelength w.
   double Depth(double r, double mu, size_t w) const;
+  // The same for the k grid wavelengths w[0..k) at once (the interpolation weights found once).
+  void Depths(double r, double mu, const size_t* w, int k, double* out) const;
 
  private:
   double bottom_, top_;
