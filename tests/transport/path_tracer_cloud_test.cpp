@@ -106,3 +106,39 @@ TEST(PathTracerCloud, GuidesLowerTheVarianceUnderADropletPeak) {
     EXPECT_LT(rg, 0.5 * rp) << "view " << v;
   }
 }
+
+// The cloud estimators act where a component peaks above sun_peak_min (30 sr^-1) and the sun
+// lights the scene: a g = 0.95 layer (62 sr^-1) takes them, a g = 0.8 one (3.6 sr^-1) and the
+// white-furnace mode do not. Their minimum path count is guided_peak_paths.
+TEST(PathTracerCloud, OnlyAPeakedComponentTakesTheCloudEstimators) {
+  const PathTracer peaked(CloudLayer(2.0, 0.95), kUnit, PathTracerSettings{});
+  EXPECT_TRUE(peaked.CloudEstimators());
+  EXPECT_EQ(peaked.MinPaths(), PathTracerSettings{}.guided_peak_paths);
+  EXPECT_FALSE(PathTracer(CloudLayer(2.0, 0.8), kUnit, PathTracerSettings{}).CloudEstimators());
+  PathTracerSettings uniform;
+  uniform.illumination = Illumination::kUniform;
+  EXPECT_FALSE(PathTracer(CloudLayer(2.0, 0.95), kUnit, uniform).CloudEstimators());
+}
+
+// Split branches are traced one after another from the path's own stream: a path gives the same
+// bits every time, and splitting changes the numbers (it happens under a droplet-like peak).
+TEST(PathTracerCloud, SplitBranchesFollowThePathsStream) {
+  const AtmosphereModel m = CloudLayer(4.0, 0.99);
+  const PathTracer split(m, kUnit, PathTracerSettings{});
+  PathTracerSettings no_split_settings;
+  no_split_settings.split_above = 0.0;
+  const PathTracer no_split(m, kUnit, no_split_settings);
+  const glm::dvec3 pos(0, 0, m.bottom_radius_m + 1.0), sun = DirectionFromAngles(40 * kDeg, 0.0);
+  const glm::dvec3 d = DirectionFromAngles(30 * kDeg, 0.0);
+  int differ = 0;
+  for (uint64_t n = 0; n < 256; ++n) {
+    double a[3], b[3], c[3];
+    split.ColorPath(pos, d, sun, 5, n, a);
+    split.ColorPath(pos, d, sun, 5, n, b);
+    no_split.ColorPath(pos, d, sun, 5, n, c);
+    EXPECT_EQ(a[1], b[1]) << "path " << n;
+    EXPECT_TRUE(std::isfinite(a[1]) && a[1] >= 0.0) << "path " << n;
+    differ += a[1] != c[1];
+  }
+  EXPECT_GT(differ, 0);
+}
