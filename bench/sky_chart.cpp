@@ -130,6 +130,9 @@ PathResult PathSky(const Scene& scene, const SkyDirections& D, double sun_zenith
   }
   fs::create_directories(cache_dir);
   WriteFileIfChanged(file, out);
+  // A reference is a cache entry: it is kept as soon as it is rendered, so that a chart stopped
+  // later (references of cloudy or deep-twilight skies take hours) does not lose it.
+  CommitOutputTransaction();
   return r;
 }
 
