@@ -63,6 +63,11 @@ struct Nodes {
   void Interpolate(const Table& tab, const RadialView& rv, const SunAzimuth& sa, double weight, float* acc) const;
 };
 
+// The radius node count (without the observer's) for a column of vertical optical depth
+// tau_total at the grid's middle wavelength: s.nr, or with s.radius_dtau > 0 at least
+// 1 + ceil(2 tau_total / radius_dtau), up to s.radius_max (and never below s.nr).
+int RadiusNodeCount(const OrdersSettings& s, double tau_total);
+
 // The nodes for settings s with a radius node at the observer's altitude.
 Nodes BuildNodes(const AtmosphereModel& m, const OrdersSettings& s, double observer_altitude_m);
 
