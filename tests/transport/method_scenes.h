@@ -102,4 +102,47 @@ inline std::array<double, 3> Dir(double theta_deg, double phi_deg) {
   return {std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t)};
 }
 
+// The sky-method tests' directions away from the aureole (view zenith, azimuth from the sun, deg):
+// zenith, mid sky, low sky and the horizon band, towards, across and away from the sun, and one
+// below the horizon.
+inline const std::vector<std::array<double, 2>>& SkyAngles() {
+  static const std::vector<std::array<double, 2>> a = {{0, 0},   {40, 90}, {60, 180}, {75, 45},   {85, 120},
+                                                       {88, 10}, {88, 90}, {88, 180}, {89.5, 60}, {95, 150}};
+  return a;
+}
+inline const std::vector<std::array<double, 3>>& SkyDirs() {
+  static const std::vector<std::array<double, 3>> d = [] {
+    std::vector<std::array<double, 3>> v;
+    for (const auto& a : SkyAngles()) v.push_back(Dir(a[0], a[1]));
+    return v;
+  }();
+  return d;
+}
+
+// A few numbers that change when the scene does (per component: the column scattering and
+// absorption optical depths at the grid's first, middle and last wavelength and the phase
+// function at 0, 90 and 180 deg at the middle one; the ground albedo and the sun's irradiance at
+// the middle one), so that a cached path reference of the scene can tell that it is stale.
+inline std::vector<double> SceneFingerprint(const TestScene& sc) {
+  const AtmosphereModel& m = sc.model;
+  const size_t nw = m.wavelengths(), mid = nw / 2;
+  std::vector<double> f;
+  for (const MediumComponent& c : m.components) {
+    for (size_t w : {size_t{0}, mid, nw - 1}) {
+      double ts = 0.0, ta = 0.0;
+      for (size_t l = 0; l + 1 < m.levels(); ++l) {
+        const double dz = m.altitude_m[l + 1] - m.altitude_m[l];
+        ts += 0.5 * (c.scattering[l * nw + w] + c.scattering[(l + 1) * nw + w]) * dz;
+        ta += 0.5 * (c.absorption[l * nw + w] + c.absorption[(l + 1) * nw + w]) * dz;
+      }
+      f.push_back(ts);
+      f.push_back(ta);
+    }
+    for (double mu : {1.0, 0.0, -1.0}) f.push_back(c.phase ? c.phase->Eval(mid, mu) : 0.0);
+  }
+  f.push_back(m.ground_albedo[mid]);
+  f.push_back(m.sun.irradiance[mid]);
+  return f;
+}
+
 }  // namespace skybake::testing

@@ -16,4 +16,5 @@ skybake_add_test_suite(NAME transport DEPS skybake_transport skybake_lut skybake
     MethodMsApprox.IsotropicSecondOrderMatchesPathTracer
     Stability.MsApproxWithDenseAerosols
     Stability.MsApproxLutInTwilight
-    PathTracerStop.ErrorBarsCoverTheSpreadUnderAThinCloud)
+    PathTracerStop.ErrorBarsCoverTheSpreadUnderAThinCloud
+    MethodOrders.HighAgainstCachedPathReferences)
