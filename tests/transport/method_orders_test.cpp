@@ -242,10 +242,11 @@ TEST(MethodOrders, HighAgainstCachedPathReferences) {
     double sun_zenith_deg;
     const char* file;
     double max_rms, max_worst;
+    const char* radius_nodes;  // Describe()'s line: the radius nodes by the optical-depth rule
   };
-  const Case cases[] = {{"cloudy1", 30.0, "cloudy1_sun30.csv", 0.012, 0.0069},
-                        {"cloudy3", 30.0, "cloudy3_sun30.csv", 0.0133, 0.0131},
-                        {"clear", 98.0, "clear_sun98.csv", 0.0356, 0.0541}};
+  const Case cases[] = {{"cloudy1", 30.0, "cloudy1_sun30.csv", 0.012, 0.0069, "radius_nodes: 16\n"},
+                        {"cloudy3", 30.0, "cloudy3_sun30.csv", 0.0133, 0.0131, "radius_nodes: 44\n"},
+                        {"clear", 98.0, "clear_sun98.csv", 0.0356, 0.0541, "radius_nodes: 16\n"}};
   std::string loaded;
   TestScene sc;
   std::unique_ptr<SkyMethod> orders;
@@ -255,6 +256,7 @@ TEST(MethodOrders, HighAgainstCachedPathReferences) {
       orders = HighOrders(sc);
       loaded = c.atmosphere;
     }
+    EXPECT_NE(orders->Describe().find(c.radius_nodes), std::string::npos) << c.atmosphere << ":\n" << orders->Describe();
     const CachedReference ref = LoadCachedReference(c.file, sc);
     if (!ref.usable) continue;
     const std::vector<double> y = MethodY(sc, *orders, c.sun_zenith_deg, SkyDirs());

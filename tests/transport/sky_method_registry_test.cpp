@@ -14,6 +14,7 @@
 #include "transport/method_analytic.h"
 #include "transport/method_ms_approx.h"
 #include "transport/method_single.h"
+#include "transport/orders/nodes.h"
 #include "transport/orders/settings.h"
 #include "transport/orders/split.h"
 #include "transport/quality.h"
@@ -197,6 +198,10 @@ TEST(Presets, OrdersTable) {
             std::vector<double>({90.0, 1.0, 93.0, 85.0}));
   EXPECT_EQ(lo.split_from_deg, 0.0);
   EXPECT_EQ(me.split_from_deg, 0.0);
+  // Radius nodes by the column's optical depth (docs/sky-methods.md "Radius nodes under a cloud"):
+  // high only, 0.2 per interval, up to 64.
+  EXPECT_EQ(std::vector<double>({lo.radius_dtau, me.radius_dtau, hi.radius_dtau}), std::vector<double>({0.0, 0.0, 0.2}));
+  EXPECT_EQ(hi.radius_max, 64);
   for (const orders::OrdersSettings* s : {&lo, &me, &hi}) {
     EXPECT_EQ(s->max_orders, 40);
     EXPECT_EQ(s->sun_low_step_deg, 0.1);
@@ -206,6 +211,23 @@ TEST(Presets, OrdersTable) {
   SkyMethodOptions o;
   EXPECT_EQ(orders::SettingsFor(o).sun_deg.size(), 42u);
   EXPECT_EQ(orders::SettingsFor(o).truncation_min_deg, 5.0);  // 0: the same as truncation_deg
+}
+
+// The radius node count: 1 + ceil(2 tau / radius_dtau) nodes keep every interval of s(h) (half by
+// the column's fraction of optical depth) within radius_dtau, never fewer than nr, never more than
+// radius_max; off (nr) when radius_dtau is 0.
+TEST(Presets, RadiusNodesFollowTheOpticalDepth) {
+  orders::OrdersSettings s;
+  s.nr = 16, s.radius_dtau = 0.2, s.radius_max = 64;
+  EXPECT_EQ(orders::RadiusNodeCount(s, 0.3), 16);    // 1 + 3: the preset's 16
+  EXPECT_EQ(orders::RadiusNodeCount(s, 1.5), 16);    // 1 + 15
+  EXPECT_EQ(orders::RadiusNodeCount(s, 2.15), 23);   // 1 + ceil(21.5)
+  EXPECT_EQ(orders::RadiusNodeCount(s, 4.25), 44);   // 1 + ceil(42.5): cloudy3
+  EXPECT_EQ(orders::RadiusNodeCount(s, 8.2), 64);    // 1 + 82, capped
+  s.radius_max = 10;                                 // a cap below nr: nr
+  EXPECT_EQ(orders::RadiusNodeCount(s, 8.2), 16);
+  s.radius_dtau = 0.0;
+  EXPECT_EQ(orders::RadiusNodeCount(s, 100.0), 16);
 }
 
 TEST(Presets, SingleMsApproxAnalyticTables) {

@@ -45,13 +45,13 @@ const std::vector<OrdersOverride>& OrdersOverrides() {
   constexpr int kMany = 4096;
   static const std::vector<OrdersOverride> overrides = {
       {"radius", K::kCount, 3, kMany, 1.0, &S::nr},
-      {"radius_dtau_x100", K::kScaled, 0, 1000, 100.0, &S::radius_dtau},
-      {"radius_max", K::kCount, 3, kMany, 1.0, &S::radius_max},
       {"view_up", K::kCount, 2, kMany, 1.0, &S::nup},
       {"view_down", K::kCount, 2, kMany, 1.0, &S::ndn},
       {"azimuth", K::kCount, 2, kMany, 1.0, &S::nphi},
       {"ray_steps", K::kCount, 4, kMany, 1.0, &S::nt},
       {"view_steps", K::kCount, 4, kMany, 1.0, &S::nss},
+      {"radius_dtau_x100", K::kScaled, 0, 1000, 100.0, &S::radius_dtau},
+      {"radius_max", K::kCount, 3, kMany, 1.0, &S::radius_max},
       {"truncation_deg", K::kScaled, 1, 90, 1.0, &S::truncation_deg},
       {"truncation_min_deg", K::kScaled, 1, 90, 1.0, &S::truncation_min_deg},
       {"normalise", K::kFlag, 0, 1, 1.0, &S::normalise},
