@@ -234,8 +234,8 @@ CachedReference LoadCachedReference(const std::string& name, const TestScene& sc
 // references is ~0.25 %); "worst" the largest |error| beyond 2 of the reference's standard
 // errors. Measured (docs/sky-methods.md "Measured accuracy"): cloudy1 sun 30 deg 0.90 % / 0.39 %,
 // cloudy3 sun 30 deg (44 radius nodes by the optical-depth rule) 1.03 % / 1.01 % (with 16 nodes
-// 4.29 % / 4.55 %), clear sun 98 deg (2-4 % references) 3.26 % / 5.11 %, where the twilight
-// target is not met. The bounds are those figures plus 0.3 %.
+// 4.29 % / 4.55 %), clear sun 98 deg (2-4 % references) 3.26 % / 5.11 %, where these references
+// cannot show the twilight target met. The bounds are those figures plus 0.3 %.
 TEST(MethodOrders, HighAgainstCachedPathReferences) {
   struct Case {
     const char* atmosphere;
