@@ -188,6 +188,10 @@ int main(int argc, char** argv) {
                       "atmosphere,sun_elevation_deg,method,quality,variant,theta_deg,phi_deg,rel_err,ref_rel_stderr\n";
     std::string refs = "# source: bench_sky_chart references (path tracer, cached)\n"
                        "atmosphere,sun_elevation_deg,target_error,paths,cpu_s,noise_rms,noise_max,cached\n";
+    // The methods of every scene: the registered ones by default, and the path tracer's rows
+    // unless --methods names methods without `path`.
+    const bool path_rows = methods.empty() || std::find(methods.begin(), methods.end(), "path") != methods.end();
+    if (methods.empty()) methods = SkyMethodNames();
 
     for (const std::string& atm : atmospheres) {
       SceneOptions base;
@@ -258,8 +262,6 @@ int main(int argc, char** argv) {
           }
         });
       };
-      const bool path_rows = methods.empty() || std::find(methods.begin(), methods.end(), "path") != methods.end();
-      if (methods.empty()) methods = SkyMethodNames();
       for (const std::string& name : methods) {
         if (name == "path") continue;
         for (const std::string& q : qualities) {
