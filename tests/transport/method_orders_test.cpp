@@ -9,12 +9,12 @@
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <map>
 #include <sstream>
 
 #include "io/csv.h"
 #include "io/error.h"
+#include "io/fileio.h"
 #include "method_scenes.h"
 #include "transport/method_orders.h"
 
@@ -201,23 +201,21 @@ struct CachedReference {
 CachedReference LoadCachedReference(const std::string& name, const TestScene& sc) {
   const std::string path = std::string(SKYBAKE_SOURCE_DIR) + "/tests/transport/references/" + name;
   CachedReference r;
-  std::ifstream in(path);
-  std::string line, source;
+  const std::string text = ReadFileBytes(path);
+  const CsvTable csv = CsvTable::Parse(text, path);
   std::vector<double> stored;
-  while (std::getline(in, line)) {
-    if (line.rfind("# source: ", 0) == 0) source = line.substr(10);
-    if (line.rfind("# scene:", 0) == 0) {
-      std::istringstream ss(line.substr(8));
-      for (double v; ss >> v;) stored.push_back(v);
-    }
+  const size_t at = text.find("\n# scene:");
+  if (at != std::string::npos) {
+    std::istringstream ss(text.substr(at + 9, text.find('\n', at + 1) - at - 9));
+    for (double v; ss >> v;) stored.push_back(v);
   }
   const std::vector<double> now = SceneFingerprint(sc);
   bool same = stored.size() == now.size();
   for (size_t i = 0; same && i < now.size(); ++i) same = std::abs(stored[i] - now[i]) <= 1e-6 * std::max(std::abs(now[i]), 1e-30);
-  EXPECT_TRUE(same) << path << " is a reference of another scene: re-render it with `build/test/bin/" << source.substr(0, source.find(" ("))
+  EXPECT_TRUE(same) << path << " is a reference of another scene: re-render it with `build/test/bin/"
+                    << csv.source().substr(0, csv.source().find(" ("))
                     << " -o " << path << "`";
   if (!same) return r;
-  const CsvTable csv = CsvTable::Load(path);
   Diagnostics d;
   r.y = csv.Numbers("Y_cd_m2", d);
   r.y_stderr = csv.Numbers("Y_stderr_cd_m2", d);
