@@ -23,7 +23,7 @@ namespace skybake::orders {
 int RadiusNodeCount(const OrdersSettings& s, double tau_total) {
   if (s.radius_dtau <= 0.0) return s.nr;
   const double need = 1.0 + std::ceil(2.0 * tau_total / s.radius_dtau);
-  return std::max(s.nr, static_cast<int>(std::min(need, static_cast<double>(std::max(s.radius_max, s.nr)))));
+  return std::max(s.nr, static_cast<int>(std::min(need, static_cast<double>(s.radius_max))));
 }
 
 Nodes BuildNodes(const AtmosphereModel& m, const OrdersSettings& s, double observer_altitude_m) {
