@@ -108,6 +108,7 @@ const Fixture& Clear() {
     x->eval = std::make_unique<FogEvaluator>(MakeEvaluator(x->products));
     SkyMethodOptions mo = o.method_options;
     mo.observer_altitude_m = x->scene.spec.observer_altitude_m;
+    mo.segments = true;
     x->orders = MakeSkyMethod("orders", x->scene.model, mo, {});
     return x;
   }();

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <stdexcept>
 
 #include <glm/geometric.hpp>
 
@@ -105,6 +106,7 @@ TEST(ViewSegment, OrdersAgreesWithPathTracer) {
   const TestScene sc = LoadTestScene("clear");
   SkyMethodOptions o;
   o.quality = Quality::kLow;
+  o.segments = true;
   const std::unique_ptr<SkyMethod> orders = MakeSkyMethod("orders", sc.model, o, {});
   ASSERT_TRUE(orders->SupportsSegments());
   PathTracerSettings ps;
@@ -154,6 +156,7 @@ TEST(ViewSegment, OrdersUnlimitedSegmentIsTheSky) {
   const TestScene sc = LoadTestScene("clear");
   SkyMethodOptions o;
   o.quality = Quality::kLow;
+  o.segments = true;
   const std::unique_ptr<SkyMethod> orders = MakeSkyMethod("orders", sc.model, o, {});
   const std::vector<std::array<double, 3>> dirs = {Dir(0, 0), Dir(45, 90), Dir(80, 0), Dir(80, 180), Dir(88, 90)};
   for (double sun_deg : {30.0, 80.0}) {
@@ -179,4 +182,26 @@ TEST(ViewSegment, OtherMethodsRefuse) {
   EXPECT_FALSE(single->SupportsSegments());
   std::vector<double> out;
   EXPECT_THROW(single->SegmentRadiance(0.0, 0.5, {Dir(0, 0)}, ViewSegment{}, &out), UsageError);
+}
+
+// orders keeps the sources that segments need only when asked (SkyMethodOptions::segments): the
+// sky is the same bytes without them, and a segment is refused.
+TEST(ViewSegment, OrdersWithoutSegmentsIsTheSameSky) {
+  const TestScene sc = LoadTestScene("cloudy1");
+  SkyMethodOptions o;
+  o.quality = Quality::kLow;
+  const std::unique_ptr<SkyMethod> sky = MakeSkyMethod("orders", sc.model, o, {});
+  o.segments = true;
+  const std::unique_ptr<SkyMethod> with = MakeSkyMethod("orders", sc.model, o, {});
+  EXPECT_FALSE(sky->SupportsSegments());
+  EXPECT_TRUE(with->SupportsSegments());
+  const std::vector<std::array<double, 3>> dirs = {Dir(0, 0), Dir(60, 90), Dir(88, 180), Dir(95, 30)};
+  for (double sun_deg : {30.0, 92.0}) {
+    std::vector<double> a, b;
+    sky->Radiance(0.0, sun_deg * kDeg, dirs, &a);
+    with->Radiance(0.0, sun_deg * kDeg, dirs, &b);
+    EXPECT_EQ(a, b) << sun_deg;
+  }
+  std::vector<double> out;
+  EXPECT_THROW(sky->SegmentRadiance(0.0, 0.5, dirs, ViewSegment{}, &out), std::logic_error);
 }

@@ -53,6 +53,7 @@ class SegmentRenderer {
     } else {
       SkyMethodOptions mo = o.method_options;
       mo.observer_altitude_m = h_;
+      mo.segments = true;
       method_ = MakeSkyMethod(o.method, scene.model, mo, progress);
       if (!method_->SupportsSegments()) {
         throw UsageError("--method " + o.method + " does not render view segments (fog); use orders or path");

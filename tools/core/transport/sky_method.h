@@ -38,6 +38,10 @@ struct SkyMethodOptions {
   // > 1: the method runs on every k-th wavelength of the grid (and the last) and the transfer is
   // interpolated to the grid (transport/spectral_stride.h); 1: every wavelength.
   int spectral_stride = 1;
+  // SegmentRadiance will be asked (fog). orders then keeps its accumulated sources J_ms at every
+  // table node (one table of the solve's size, 156 MB for high under cloudy4 on 21 wavelengths);
+  // without it SegmentRadiance throws UsageError and the sky's bytes are the same.
+  bool segments = false;
 };
 
 class SkyMethod {

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include <optional>
+#include <stdexcept>
 
 #include "transport/method_orders.h"
 #include "transport/orders/render.h"
@@ -18,13 +19,14 @@ namespace {
 // of its answers.
 class OrdersSolve {
  public:
-  OrdersSolve(const AtmosphereModel& model, const orders::OrdersSettings& s, double observer_altitude_m, const ProgressFn& progress)
+  OrdersSolve(const AtmosphereModel& model, const orders::OrdersSettings& s, double observer_altitude_m, bool segments,
+              const ProgressFn& progress)
       : m_(model), s_(s) {
     ss_scaled_ = s_.ss_scaled && s_.max_orders >= 2;
     md_ = orders::PrepareMedium(m_, s_, ss_scaled_ && s_.ss_scaled_view > 0);
     sun_ = orders::BuildSunTables(m_, md_, s_);
     nodes_ = orders::BuildNodes(m_, s_, observer_altitude_m);
-    res_ = orders::SolveMultipleScattering(m_, md_, sun_, nodes_, s_, progress);
+    res_ = orders::SolveMultipleScattering(m_, md_, sun_, nodes_, s_, segments, progress);
   }
 
   // The resolved settings, one "key: value" line each, every key prefixed by `prefix`.
@@ -70,14 +72,14 @@ class OrdersSolve {
 class OrdersMethod : public SkyMethod {
  public:
   OrdersMethod(const AtmosphereModel& model, const SkyMethodOptions& options, const ProgressFn& progress)
-      : s_(orders::SettingsFor(options)) {
+      : s_(orders::SettingsFor(options)), segments_(options.segments) {
     if (s_.split_from_deg <= 0.0) {
-      day_.emplace(model, s_, options.observer_altitude_m, progress);
+      day_.emplace(model, s_, options.observer_altitude_m, segments_, progress);
       return;
     }
     const orders::SplitSettings parts = orders::SplitParts(s_);
-    day_.emplace(model, parts.day, options.observer_altitude_m, progress);
-    twilight_.emplace(model, parts.twilight, options.observer_altitude_m, progress);
+    day_.emplace(model, parts.day, options.observer_altitude_m, segments_, progress);
+    twilight_.emplace(model, parts.twilight, options.observer_altitude_m, segments_, progress);
   }
 
   std::string Name() const override { return "orders"; }
@@ -102,9 +104,11 @@ class OrdersMethod : public SkyMethod {
     Answer(observer_altitude_m, sun_zenith_rad, dirs, nullptr, &total, out);
     return true;
   }
-  bool SupportsSegments() const override { return true; }
+  // Segments need the sources kept by the solve (SkyMethodOptions::segments).
+  bool SupportsSegments() const override { return segments_; }
   void SegmentRadiance(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,
                        const ViewSegment& segment, std::vector<double>* out) const override {
+    if (!segments_) throw std::logic_error("orders: SegmentRadiance on a method built without SkyMethodOptions::segments");
     Answer(observer_altitude_m, sun_zenith_rad, dirs, &segment, out, nullptr);
   }
 
@@ -126,6 +130,7 @@ class OrdersMethod : public SkyMethod {
   }
 
   orders::OrdersSettings s_;
+  bool segments_ = false;
   std::optional<OrdersSolve> day_, twilight_;  // day_ alone without the split
 };
 

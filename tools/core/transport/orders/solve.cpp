@@ -213,7 +213,7 @@ SecondMode EstimateSecondMode(const Nodes& nodes, size_t nd, double ratio, const
   return m;
 }
 
-// Adds the two modes' tail (SecondMode) to ms and, through one more scattering step, to jms:
+// Adds the two modes' tail (SecondMode) to ms and, through one more scattering step, to jms (if kept):
 // sum_{k>n} J_k = Scatter(sum_{k>=n} L_k), the sources of the radiance's remaining orders. An
 // element's tail is kept non-negative. L is overwritten (it holds L_n + the tail for the step).
 void AddTwoModeTail(const KernelContext& kc, const ScatterKernels& sk, const Nodes& nodes, const OrdersSettings& s, size_t nd,
@@ -238,6 +238,8 @@ void AddTwoModeTail(const KernelContext& kc, const ScatterKernels& sk, const Nod
       for (size_t w = 0; w < nw; ++w) o[w] += tail_at(e0 + w);
     }
   }
+  out->tail = Tail::kTwoModes;
+  if (out->jms.empty()) return;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, t->L.size(), size_t{1} << 18), [&](const tbb::blocked_range<size_t>& rg) {
     for (size_t i = rg.begin(); i != rg.end(); ++i) t->L[i] = t->Lnext[i] + tail_at(i);
   });
@@ -245,7 +247,6 @@ void AddTwoModeTail(const KernelContext& kc, const ScatterKernels& sk, const Nod
   tbb::parallel_for(tbb::blocked_range<size_t>(0, out->jms.size(), size_t{1} << 18), [&](const tbb::blocked_range<size_t>& rg) {
     for (size_t i = rg.begin(); i != rg.end(); ++i) out->jms[i] += t->J[i];
   });
-  out->tail = Tail::kTwoModes;
 }
 
 // Whether the two modes' tail may be considered: the tail too large a share for the early
@@ -291,7 +292,7 @@ double AccumulateAtObserver(const Nodes& nodes, size_t nd, const Table& L, std::
 }  // namespace
 
 SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, const SunTables& sun, const Nodes& nodes,
-                                    const OrdersSettings& s, const ProgressFn& progress) {
+                                    const OrdersSettings& s, bool keep_sources, const ProgressFn& progress) {
   const size_t nw = md.nw, nr = nodes.radius.size(), nphi = static_cast<size_t>(s.nphi);
   const size_t cells = nr * nodes.ns * nodes.nu * nphi;
   const std::vector<Family> fam = BuildFamilies(m, md, nodes, s);
@@ -309,7 +310,7 @@ SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, 
 
   SolveResult out;
   out.ms.assign(nodes.ns * nodes.nu * nphi * nw, 0.0f);
-  ZeroTable(&out.jms, cells * nw);
+  if (keep_sources) ZeroTable(&out.jms, cells * nw);
   const size_t nd = nodes.nu * nphi;  // directions per (radius, sun)
   RatioHistory h;
   std::vector<double> norm_w, ratio_w(nw);

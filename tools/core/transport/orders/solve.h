@@ -27,14 +27,15 @@ enum class Tail {
 struct SolveResult {
   std::vector<float> ms;  // accumulated orders >= 2 at the observer radius: [(si*nu+k)*nphi+q]*nw
   // Accumulated multiple-scattering source J_ms* = sum_{n>=2} J_n at every node (cells x nw),
-  // for view segments: L_seg,ms = int_0^t_end T* J_ms* dt.
+  // for view segments: L_seg,ms = int_0^t_end T* J_ms* dt; empty unless the solve keeps sources.
   Table jms;
   int orders_done = 0;
   Tail tail = Tail::kNone;
   double last_fraction = 0.0;
 };
 
+// keep_sources: accumulate jms (view segments need it; the sky alone reads ms).
 SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, const SunTables& sun, const Nodes& nodes,
-                                    const OrdersSettings& s, const ProgressFn& progress);
+                                    const OrdersSettings& s, bool keep_sources, const ProgressFn& progress);
 
 }  // namespace skybake::orders
