@@ -5,8 +5,8 @@
 // standard error of Y. The file holds the scene's fingerprint (SceneFingerprint), so that a test
 // can tell a reference of another scene; re-render after a change of the scene or the tracer:
 //
-//   build/test/bin/bench_test_references --atmosphere cloudy1 --sun-zenith-deg 30 --target-error 0.01 \
-//       -o tests/transport/references/cloudy1_sun30.csv
+//   build/test/bin/bench_test_references --atmosphere cloudy1 --sun-zenith-deg 30 --target-error 0.01
+//       -o tests/transport/references/cloudy1_sun30.csv    (one command line)
 //
 // Directions run in parallel (--threads); each is one estimate with its own stream, so the file's
 // numbers do not depend on the thread count (its cpu_s column does).

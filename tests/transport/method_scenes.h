@@ -3,15 +3,22 @@
 // test in a few seconds), and a homogeneous shell with closed forms.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <memory>
 #include <numbers>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include <glm/vec3.hpp>
 
 #include "atmosphere/mie_optics.h"
 #include "atmosphere/model_build.h"
+#include "io/csv.h"
+#include "io/error.h"
+#include "io/fileio.h"
 #include "optics/particle_type.h"
 #include "optics/polydisperse.h"
 #include "spectrum/cmf.h"
@@ -143,6 +150,40 @@ inline std::vector<double> SceneFingerprint(const TestScene& sc) {
   f.push_back(m.ground_albedo[mid]);
   f.push_back(m.sun.irradiance[mid]);
   return f;
+}
+
+// A cached path reference of the tests' scene (tests/transport/references/, made by
+// bench_test_references): Y and its standard error per SkyDirs direction, and whether its
+// fingerprint is the scene's (each number within 1e-6 relative); `source` is its command line.
+struct CachedReference {
+  std::vector<double> y, y_stderr;
+  bool same_scene = false;
+  std::string path, source;
+};
+
+inline CachedReference ReadCachedReference(const std::string& name, const TestScene& sc) {
+  CachedReference r;
+  r.path = std::string(SKYBAKE_SOURCE_DIR) + "/tests/transport/references/" + name;
+  const std::string text = ReadFileBytes(r.path);
+  const CsvTable csv = CsvTable::Parse(text, r.path);
+  r.source = csv.source();
+  std::vector<double> stored;
+  const size_t at = text.find("\n# scene:");
+  if (at != std::string::npos) {
+    std::istringstream ss(text.substr(at + 9, text.find('\n', at + 1) - at - 9));
+    for (double v; ss >> v;) stored.push_back(v);
+  }
+  const std::vector<double> now = SceneFingerprint(sc);
+  r.same_scene = stored.size() == now.size();
+  for (size_t i = 0; r.same_scene && i < now.size(); ++i) {
+    r.same_scene = std::abs(stored[i] - now[i]) <= 1e-6 * std::max(std::abs(now[i]), 1e-30);
+  }
+  if (!r.same_scene) return r;
+  Diagnostics d;
+  r.y = csv.Numbers("Y_cd_m2", d);
+  r.y_stderr = csv.Numbers("Y_stderr_cd_m2", d);
+  d.ThrowIfAny();
+  return r;
 }
 
 }  // namespace skybake::testing

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 #include <string>
 
@@ -199,8 +200,8 @@ TEST(Presets, OrdersTable) {
   EXPECT_EQ(lo.split_from_deg, 0.0);
   EXPECT_EQ(me.split_from_deg, 0.0);
   // Radius nodes by the column's optical depth (docs/sky-methods.md "Radius nodes under a cloud"):
-  // high only, 0.2 per interval, up to 64.
-  EXPECT_EQ(std::vector<double>({lo.radius_dtau, me.radius_dtau, hi.radius_dtau}), std::vector<double>({0.0, 0.0, 0.2}));
+  // high only, intervals over 0.15 split, up to 64.
+  EXPECT_EQ(std::vector<double>({lo.radius_dtau, me.radius_dtau, hi.radius_dtau}), std::vector<double>({0.0, 0.0, 0.15}));
   EXPECT_EQ(hi.radius_max, 64);
   for (const orders::OrdersSettings* s : {&lo, &me, &hi}) {
     EXPECT_EQ(s->max_orders, 40);
@@ -213,21 +214,49 @@ TEST(Presets, OrdersTable) {
   EXPECT_EQ(orders::SettingsFor(o).truncation_min_deg, 5.0);  // 0: the same as truncation_deg
 }
 
-// The radius node count: 1 + ceil(2 tau / radius_dtau) nodes keep every interval of s(h) (half by
-// the column's fraction of optical depth) within radius_dtau, never fewer than nr, never more than
-// radius_max; off (nr) when radius_dtau is 0.
+// The radius nodes: the preset's nr nodes uniform in s(h), and every interval of them whose
+// vertical optical depth exceeds radius_dtau split into equal optical-depth pieces, never more
+// than radius_max nodes in all (the pieces then grow), the nr nodes alone when radius_dtau is 0
+// or radius_max is below nr. A synthetic column: 0.1 of air (scale height 8 km) and a 2 km
+// layer of optical depth tau_c at 3.5-5.5 km, uniform in extinction.
 TEST(Presets, RadiusNodesFollowTheOpticalDepth) {
+  const double H = 100e3;
+  double tau_c = 0.0;
+  auto tau_of = [&](double h) { return 0.1 * (1.0 - std::exp(-h / 8000.0)) + tau_c * std::clamp((h - 3500.0) / 2000.0, 0.0, 1.0); };
   orders::OrdersSettings s;
-  s.nr = 16, s.radius_dtau = 0.2, s.radius_max = 64;
-  EXPECT_EQ(orders::RadiusNodeCount(s, 0.3), 16);    // 1 + 3: the preset's 16
-  EXPECT_EQ(orders::RadiusNodeCount(s, 1.5), 16);    // 1 + 15
-  EXPECT_EQ(orders::RadiusNodeCount(s, 2.15), 23);   // 1 + ceil(21.5)
-  EXPECT_EQ(orders::RadiusNodeCount(s, 4.25), 44);   // 1 + ceil(42.5): cloudy3
-  EXPECT_EQ(orders::RadiusNodeCount(s, 8.2), 64);    // 1 + 82, capped
-  s.radius_max = 10;                                 // a cap below nr: nr
-  EXPECT_EQ(orders::RadiusNodeCount(s, 8.2), 16);
-  s.radius_dtau = 0.0;
-  EXPECT_EQ(orders::RadiusNodeCount(s, 100.0), 16);
+  s.nr = 16, s.radius_dtau = 0.15, s.radius_max = 64;
+  const std::vector<double> clear = orders::RadiusNodeAltitudes(s, tau_of, H);
+  ASSERT_EQ(clear.size(), 16u);  // no interval of the clear column holds 0.15
+  EXPECT_EQ(clear.front(), 0.0);
+  EXPECT_NEAR(clear.back(), H, 1e-3);
+  auto max_piece = [&](const std::vector<double>& h) {
+    double d = 0.0;
+    for (size_t i = 0; i + 1 < h.size(); ++i) {
+      EXPECT_LT(h[i], h[i + 1]) << i;
+      d = std::max(d, tau_of(h[i + 1]) - tau_of(h[i]));
+    }
+    return d;
+  };
+  tau_c = 2.0;
+  const std::vector<double> thin = orders::RadiusNodeAltitudes(s, tau_of, H);
+  EXPECT_GT(thin.size(), 16u);
+  EXPECT_LE(thin.size(), 64u);
+  EXPECT_LE(max_piece(thin), 0.15 * (1.0 + 1e-6));  // every piece within radius_dtau
+  // The base nodes of the same column are all kept (refinement only adds).
+  orders::OrdersSettings base = s;
+  base.radius_dtau = 0.0;
+  for (double h : orders::RadiusNodeAltitudes(base, tau_of, H)) {
+    EXPECT_TRUE(std::any_of(thin.begin(), thin.end(), [&](double x) { return std::abs(x - h) < 1e-9; })) << h;
+  }
+  tau_c = 16.0;  // would need > 100 pieces of 0.15: capped at 64, the pieces as even as the cap allows
+  const std::vector<double> thick = orders::RadiusNodeAltitudes(s, tau_of, H);
+  EXPECT_GE(thick.size(), 60u);
+  EXPECT_LE(thick.size(), 64u);
+  EXPECT_LT(max_piece(thick), 0.4);  // 16 over the ~48 pieces the cap leaves the layer
+  s.radius_max = 10;  // a cap below nr: the nr nodes
+  EXPECT_EQ(orders::RadiusNodeAltitudes(s, tau_of, H).size(), 16u);
+  s.radius_max = 64, s.radius_dtau = 0.0;
+  EXPECT_EQ(orders::RadiusNodeAltitudes(s, tau_of, H).size(), 16u);
 }
 
 TEST(Presets, SingleMsApproxAnalyticTables) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "transport/orders/grid.h"
@@ -63,10 +64,11 @@ struct Nodes {
   void Interpolate(const Table& tab, const RadialView& rv, const SunAzimuth& sa, double weight, float* acc) const;
 };
 
-// The radius node count (without the observer's) for a column of vertical optical depth
-// tau_total at the grid's middle wavelength: s.nr, or with s.radius_dtau > 0 at least
-// 1 + ceil(2 tau_total / radius_dtau), up to s.radius_max (and never below s.nr).
-int RadiusNodeCount(const OrdersSettings& s, double tau_total);
+// The radius nodes' altitudes (m, ascending, 0 to H) for a column whose vertical optical depth from
+// the ground to altitude h is tau_of(h): s.nr nodes uniform in s(h), each interval holding more
+// than s.radius_dtau split into equal optical-depth pieces, at most s.radius_max nodes in all (the
+// pieces are then the smallest that fit; nodes.cpp).
+std::vector<double> RadiusNodeAltitudes(const OrdersSettings& s, const std::function<double(double)>& tau_of, double H);
 
 // The nodes for settings s with a radius node at the observer's altitude.
 Nodes BuildNodes(const AtmosphereModel& m, const OrdersSettings& s, double observer_altitude_m);

@@ -29,10 +29,11 @@ const QualityTable<OrdersSettings>& OrdersPresets() {
       // 0.86 / 1.35 / 1.63 % RMS (max 2.5 / 3.2 / 4.1 %) from one solve at high at sun 92 / 95 /
       // 100 deg there; medium's view nodes would put the ground 1 deg below the horizon at 5x the
       // one solve's radiance (its first down node is 1.8 deg below the horizon, high's 0.7 deg).
-      // Under a cloud the radius nodes follow its optical depth, <= 0.2 per interval (cloudy3: 44
-      // nodes; +2 ... +6.6 % against its 1 % path reference with 16, within 1.1 % RMS with 44), up
-      // to 64 (docs/sky-methods.md "Radius nodes under a cloud").
-      OrdersSettings{.radius_dtau = 0.2, .nup = 24, .ndn = 12, .nphi = 36, .nss = 96, .fine = 512, .truncation_deg = 3.0,
+      // Under a cloud every interval of the 16 radius nodes holding more than 0.15 of optical depth
+      // is split into equal optical-depth pieces, up to 64 nodes (cloudy3: 38 nodes, 0.75 % RMS off
+      // its sky with 92 nodes; +2 ... +6.6 % against its 1 % path reference with 16; docs/sky-methods.md
+      // "Radius nodes under a cloud").
+      OrdersSettings{.radius_dtau = 0.15, .nup = 24, .ndn = 12, .nphi = 36, .nss = 96, .fine = 512, .truncation_deg = 3.0,
                      .truncation_min_deg = 1.0, .sun_nr = 192, .kernel_sub = 4, .tolerance = 3e-4,
                      .split_from_deg = 90.0, .split_width_deg = 1.0, .split_day_to_deg = 93.0, .split_twilight_from_deg = 85.0},
   }};

@@ -13,9 +13,9 @@ namespace skybake::orders {
 
 struct OrdersSettings {
   int nr = 16;               // radius nodes (+ the observer's), at least
-  // > 0: more radius nodes where the column is optically thick, so that no interval holds more
-  // than this vertical optical depth (at the grid's middle wavelength), up to radius_max nodes
-  // (RadiusNodeCount in nodes.h; docs/sky-methods.md "Radius nodes under a cloud"). 0: nr.
+  // > 0: every interval of the nr nodes holding more than this vertical optical depth (at the
+  // grid's middle wavelength) split into equal optical-depth pieces, up to radius_max nodes in all
+  // (RadiusNodeAltitudes in nodes.h; docs/sky-methods.md "Radius nodes under a cloud"). 0: nr.
   double radius_dtau = 0.0;
   int radius_max = 64;
   int nup = 16, ndn = 8;     // view nodes above / below each altitude's horizon

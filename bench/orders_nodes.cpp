@@ -1,0 +1,117 @@
+// bench_orders_nodes: the error of `orders` table settings, measured against the same method with
+// those settings converged (no noise) and against the cached path reference of the tests
+// (tests/transport/references/, noise-corrected RMS), on the tests' scene of an atmosphere
+// (tests/transport/method_scenes.h, 20 nm grid) and their ten directions (SkyAngles), `high` plus
+// expert overrides. docs/sky-methods.md "Radius nodes under a cloud" has its figures:
+//
+//   build/test/bin/bench_orders_nodes --atmosphere cloudy4 --converged radius_dtau_x100=8,radius_max=140
+//       --candidates radius_dtau_x100=15 radius_dtau_x100=25 radius_dtau_x100=0,radius=64    (one command line)
+//
+// Per candidate: its radius nodes, its build's wall time, RMS and max |error| against the
+// converged settings and against the path (the reference file <atmosphere>_sun<Z>.csv, if it is
+// of this scene).
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "io/cli.h"
+#include "io/error.h"
+#include "transport/method_scenes.h"
+#include "transport/sky_method.h"
+
+using namespace skybake;
+using namespace skybake::testing;
+
+namespace {
+
+// "key=value,key=value" into SkyMethodOptions::table_size.
+std::map<std::string, int> ParseOverrides(const std::string& text) {
+  std::map<std::string, int> out;
+  size_t p = 0;
+  while (p < text.size()) {
+    size_t e = text.find(',', p);
+    if (e == std::string::npos) e = text.size();
+    const std::string kv = text.substr(p, e - p);
+    const size_t eq = kv.find('=');
+    if (eq == std::string::npos || eq == 0) throw UsageError("an override is key=value: '" + kv + "'");
+    try {
+      out[kv.substr(0, eq)] = std::stoi(kv.substr(eq + 1));
+    } catch (const std::exception&) {
+      throw UsageError("an override's value is an integer: '" + kv + "'");
+    }
+    p = e + 1;
+  }
+  return out;
+}
+
+struct Solve {
+  std::vector<double> y;
+  double seconds = 0.0;
+  std::string nodes;
+};
+
+Solve Run(const TestScene& sc, const std::string& overrides, double sun_zenith_deg) {
+  SkyMethodOptions o;
+  o.quality = Quality::kHigh;
+  o.table_size = ParseOverrides(overrides);
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::unique_ptr<SkyMethod> m = MakeSkyMethod("orders", sc.model, o, {});
+  Solve s;
+  s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::vector<double> L;
+  m->Radiance(1.0, sun_zenith_deg * kDeg, SkyDirs(), &L);
+  for (size_t d = 0; d < SkyDirs().size(); ++d) s.y.push_back(sc.Y(L.data() + d * sc.model.wavelengths()));
+  const std::string desc = m->Describe();
+  const size_t at = desc.find("radius_nodes: ");
+  s.nodes = at == std::string::npos ? "?" : desc.substr(at + 14, desc.find('\n', at) - at - 14);
+  return s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  ToolCli cli("bench_orders_nodes", "The error of orders table settings against converged settings and the cached path reference.");
+  std::string atmosphere = "cloudy4", converged;
+  double sun_zenith = 30.0;
+  std::vector<std::string> candidates;
+  cli.app().add_option("--atmosphere", atmosphere, "Atmosphere (atmospheres/<name>.yaml)");
+  cli.app().add_option("--sun-zenith-deg", sun_zenith, "Sun zenith angle (deg)")->check(CLI::Range(0.0, 120.0));
+  cli.app().add_option("--converged", converged, "Overrides of the converged solve (key=value,...); empty: none")->required();
+  cli.app().add_option("--candidates", candidates, "Overrides of each candidate (key=value,...; \"\" is high itself)")->required();
+  return cli.Run(argc, argv, [&] {
+    const TestScene sc = LoadTestScene(atmosphere);
+    const std::string ref_name = fmt::format("{}_sun{:g}.csv", atmosphere, sun_zenith);
+    CachedReference ref;
+    if (std::filesystem::exists(std::string(SKYBAKE_SOURCE_DIR) + "/tests/transport/references/" + ref_name)) {
+      ref = ReadCachedReference(ref_name, sc);
+      if (!ref.same_scene) std::printf("%s is of another scene: no comparison with the path\n", ref_name.c_str());
+    }
+    const Solve conv = Run(sc, converged, sun_zenith);
+    std::printf("%s sun %g deg, converged (%s): %s radius nodes, %.0f s\n", atmosphere.c_str(), sun_zenith, converged.c_str(),
+                conv.nodes.c_str(), conv.seconds);
+    std::printf("%-40s %6s %8s  %-22s %-22s\n", "candidate", "nodes", "build s", "vs converged RMS (max)", "vs path RMS (max)");
+    for (const std::string& c : candidates) {
+      const Solve s = Run(sc, c, sun_zenith);
+      double ss = 0.0, mx = 0.0, sp = 0.0, noise = 0.0, mp = 0.0;
+      for (size_t d = 0; d < s.y.size(); ++d) {
+        const double e = s.y[d] / conv.y[d] - 1.0;
+        ss += e * e, mx = std::max(mx, std::abs(e));
+        if (ref.same_scene) {
+          const double ep = s.y[d] / ref.y[d] - 1.0, sd = ref.y_stderr[d] / ref.y[d];
+          sp += ep * ep, noise += sd * sd, mp = std::max(mp, std::abs(ep));
+        }
+      }
+      const double n = static_cast<double>(s.y.size());
+      const std::string path = ref.same_scene ? fmt::format("{:.2f} % ({:.2f})", 100.0 * std::sqrt(std::max(0.0, sp - noise) / n), 100.0 * mp)
+                                              : std::string("-");
+      std::printf("%-40s %6s %8.0f  %-22s %-22s\n", c.empty() ? "(high)" : c.c_str(), s.nodes.c_str(), s.seconds,
+                  fmt::format("{:.2f} % ({:.2f})", 100.0 * std::sqrt(ss / n), 100.0 * mx).c_str(), path.c_str());
+    }
+  });
+}
