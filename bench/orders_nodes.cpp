@@ -64,9 +64,7 @@ Solve Run(const TestScene& sc, const std::string& overrides, double sun_zenith_d
   const std::unique_ptr<SkyMethod> m = MakeSkyMethod("orders", sc.model, o, {});
   Solve s;
   s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::vector<double> L;
-  m->Radiance(1.0, sun_zenith_deg * kDeg, SkyDirs(), &L);
-  for (size_t d = 0; d < SkyDirs().size(); ++d) s.y.push_back(sc.Y(L.data() + d * sc.model.wavelengths()));
+  s.y = MethodY(sc, *m, sun_zenith_deg, SkyDirs());
   const std::string desc = m->Describe();
   const size_t at = desc.find("radius_nodes: ");
   s.nodes = at == std::string::npos ? "?" : desc.substr(at + 14, desc.find('\n', at) - at - 14);
@@ -88,7 +86,7 @@ int main(int argc, char** argv) {
     const TestScene sc = LoadTestScene(atmosphere);
     const std::string ref_name = fmt::format("{}_sun{:g}.csv", atmosphere, sun_zenith);
     CachedReference ref;
-    if (std::filesystem::exists(std::string(SKYBAKE_SOURCE_DIR) + "/tests/transport/references/" + ref_name)) {
+    if (std::filesystem::exists(CachedReferencePath(ref_name))) {
       ref = ReadCachedReference(ref_name, sc);
       if (!ref.same_scene) std::printf("%s is of another scene: no comparison with the path\n", ref_name.c_str());
     }

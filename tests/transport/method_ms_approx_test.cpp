@@ -41,15 +41,6 @@ std::vector<ColorEstimate> PathY(const TestScene& sc, double sun_zenith_deg, con
   return out;
 }
 
-std::vector<double> MethodY(const TestScene& sc, const SkyMethod& method, double sun_zenith_deg,
-                            const std::vector<std::array<double, 3>>& dirs) {
-  std::vector<double> L;
-  method.Radiance(1.0, sun_zenith_deg * kDeg, dirs, &L);
-  std::vector<double> y;
-  for (size_t d = 0; d < dirs.size(); ++d) y.push_back(sc.Y(L.data() + d * sc.model.wavelengths()));
-  return y;
-}
-
 }  // namespace
 
 // f_ms is the fraction of isotropically emitted light scattered back: deep inside a thick

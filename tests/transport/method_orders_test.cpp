@@ -10,11 +10,9 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
-#include <sstream>
+#include <optional>
 
-#include "io/csv.h"
 #include "io/error.h"
-#include "io/fileio.h"
 #include "method_scenes.h"
 #include "transport/method_orders.h"
 
@@ -35,15 +33,6 @@ std::vector<ColorEstimate> PathY(const TestScene& sc, double sun_zenith_deg, con
     out[d] = pt.Radiance(x, glm::dvec3(dirs[d][0], dirs[d][1], dirs[d][2]), DirectionFromAngles(sun_zenith_deg * kDeg, 0), 300 + d);
   });
   return out;
-}
-
-std::vector<double> MethodY(const TestScene& sc, const SkyMethod& method, double sun_zenith_deg,
-                            const std::vector<std::array<double, 3>>& dirs) {
-  std::vector<double> L;
-  method.Radiance(1.0, sun_zenith_deg * kDeg, dirs, &L);
-  std::vector<double> y;
-  for (size_t d = 0; d < dirs.size(); ++d) y.push_back(sc.Y(L.data() + d * sc.model.wavelengths()));
-  return y;
 }
 
 // The 10 nm grid (41 wavelengths) of the tests of `high` against the target: on the 20 nm
@@ -189,23 +178,16 @@ TEST(MethodOrders, HighAtTheDaylightTargetOnTheHazedSky) {
   }
 }
 
-// A cached path reference (ReadCachedReference) that the test can use: one of another scene fails
-// the test with the command that re-renders it.
-struct UsableReference {
-  std::vector<double> y, y_stderr;
-  bool usable = false;
-};
-
-UsableReference LoadCachedReference(const std::string& name, const TestScene& sc) {
-  const CachedReference c = ReadCachedReference(name, sc);
+// A cached path reference (ReadCachedReference) of the scene with a value per SkyDirs direction;
+// one of another scene fails the test with the command that re-renders it.
+std::optional<CachedReference> LoadCachedReference(const std::string& name, const TestScene& sc) {
+  CachedReference c = ReadCachedReference(name, sc);
   EXPECT_TRUE(c.same_scene) << c.path << " is a reference of another scene: re-render it with `build/test/bin/"
                             << c.source.substr(0, c.source.find(" (")) << " -o " << c.path << "`";
-  UsableReference r;
-  if (!c.same_scene) return r;
-  r.y = c.y, r.y_stderr = c.y_stderr;
-  EXPECT_EQ(r.y.size(), SkyDirs().size()) << c.path;
-  r.usable = r.y.size() == SkyDirs().size();
-  return r;
+  if (!c.same_scene) return std::nullopt;
+  EXPECT_EQ(c.y.size(), SkyDirs().size()) << c.path;
+  if (c.y.size() != SkyDirs().size()) return std::nullopt;
+  return c;
 }
 
 // `high` against cached path references of the tests' scene at the other targets: under
@@ -239,8 +221,9 @@ TEST(MethodOrders, HighAgainstCachedPathReferences) {
       loaded = c.atmosphere;
     }
     EXPECT_NE(orders->Describe().find(c.radius_nodes), std::string::npos) << c.atmosphere << ":\n" << orders->Describe();
-    const UsableReference ref = LoadCachedReference(c.file, sc);
-    if (!ref.usable) continue;
+    const std::optional<CachedReference> found = LoadCachedReference(c.file, sc);
+    if (!found) continue;
+    const CachedReference& ref = *found;
     const std::vector<double> y = MethodY(sc, *orders, c.sun_zenith_deg, SkyDirs());
     double ss = 0.0, noise = 0.0, worst = 0.0;
     for (size_t d = 0; d < y.size(); ++d) {

@@ -24,6 +24,7 @@
 #include "spectrum/cmf.h"
 #include "spectrum/xyz.h"
 #include "transport/path_tracer.h"
+#include "transport/sky_method.h"
 
 namespace skybake::testing {
 
@@ -152,6 +153,16 @@ inline std::vector<double> SceneFingerprint(const TestScene& sc) {
   return f;
 }
 
+// Y (cd/m^2) of a method's sky seen from 1 m above the ground, per direction.
+inline std::vector<double> MethodY(const TestScene& sc, const SkyMethod& method, double sun_zenith_deg,
+                                   const std::vector<std::array<double, 3>>& dirs) {
+  std::vector<double> L;
+  method.Radiance(1.0, sun_zenith_deg * kDeg, dirs, &L);
+  std::vector<double> y;
+  for (size_t d = 0; d < dirs.size(); ++d) y.push_back(sc.Y(L.data() + d * sc.model.wavelengths()));
+  return y;
+}
+
 // A cached path reference of the tests' scene (tests/transport/references/, made by
 // bench_test_references): Y and its standard error per SkyDirs direction, and whether its
 // fingerprint is the scene's (each number within 1e-6 relative); `source` is its command line.
@@ -161,9 +172,13 @@ struct CachedReference {
   std::string path, source;
 };
 
+inline std::string CachedReferencePath(const std::string& name) {
+  return std::string(SKYBAKE_SOURCE_DIR) + "/tests/transport/references/" + name;
+}
+
 inline CachedReference ReadCachedReference(const std::string& name, const TestScene& sc) {
   CachedReference r;
-  r.path = std::string(SKYBAKE_SOURCE_DIR) + "/tests/transport/references/" + name;
+  r.path = CachedReferencePath(name);
   const std::string text = ReadFileBytes(r.path);
   const CsvTable csv = CsvTable::Parse(text, r.path);
   r.source = csv.source();

@@ -74,6 +74,16 @@ struct Lerp {
 }
 Lerp Locate(const std::vector<double>& x, double v);
 
+// The altitude in [lo, hi] where a non-decreasing f reaches `target`, by bisection to 1 mm.
+template <class F>
+double AltitudeWhere(const F& f, double target, double lo, double hi) {
+  for (int it = 0; it < 60 && hi - lo > 1e-3; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    (f(mid) < target ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
 // n altitudes in [0, H] uniform in a monotone s(h) with s(0) = 0 and s(H) = 1 (bisection to 1 mm;
 // the ends exactly 0 and H): the node placements that follow both altitude and optical depth.
 template <class S>
@@ -81,14 +91,7 @@ std::vector<double> AltitudesUniformIn(const S& s_of, int n, double H) {
   std::vector<double> h;
   for (int i = 0; i < n; ++i) {
     const double u = static_cast<double>(i) / (n - 1);
-    double lo = 0.0, hi = H;
-    if (i == 0) hi = 0.0;
-    if (i == n - 1) lo = H;
-    for (int it = 0; it < 60 && hi - lo > 1e-3; ++it) {
-      const double mid = 0.5 * (lo + hi);
-      (s_of(mid) < u ? lo : hi) = mid;
-    }
-    h.push_back(0.5 * (lo + hi));
+    h.push_back(AltitudeWhere(s_of, u, i == n - 1 ? H : 0.0, i == 0 ? 0.0 : H));
   }
   return h;
 }

@@ -29,8 +29,9 @@ std::vector<double> RadiusNodeAltitudes(const OrdersSettings& s, const std::func
   auto s_of = [&](double h) { return 0.5 * (tau_of(h) / tau_total + std::pow(h / H, 0.4)); };
   const std::vector<double> base = AltitudesUniformIn(s_of, s.nr, H);
   if (s.radius_dtau <= 0.0) return base;
-  std::vector<double> dtau(base.size() - 1);
-  for (size_t i = 0; i + 1 < base.size(); ++i) dtau[i] = tau_of(base[i + 1]) - tau_of(base[i]);
+  std::vector<double> tau_base(base.size()), dtau(base.size() - 1);
+  for (size_t i = 0; i < base.size(); ++i) tau_base[i] = tau_of(base[i]);
+  for (size_t i = 0; i + 1 < base.size(); ++i) dtau[i] = tau_base[i + 1] - tau_base[i];
   auto pieces = [&](double d, size_t i) { return std::max(1.0, std::ceil(dtau[i] / d - 1e-9)); };
   auto count = [&](double d) {
     double n = 1.0;
@@ -50,17 +51,8 @@ std::vector<double> RadiusNodeAltitudes(const OrdersSettings& s, const std::func
   std::vector<double> h{base.front()};
   for (size_t i = 0; i < dtau.size(); ++i) {
     const int m = static_cast<int>(pieces(d, i));
-    const double t0 = tau_of(base[i]);
-    for (int j = 1; j < m; ++j) {
-      // The altitude where the optical depth from base[i] is j/m of the interval's.
-      const double target = t0 + dtau[i] * j / m;
-      double lo = base[i], hi = base[i + 1];
-      for (int it = 0; it < 60 && hi - lo > 1e-3; ++it) {
-        const double mid = 0.5 * (lo + hi);
-        (tau_of(mid) < target ? lo : hi) = mid;
-      }
-      h.push_back(0.5 * (lo + hi));
-    }
+    // The altitudes where the optical depth from base[i] is j/m of the interval's.
+    for (int j = 1; j < m; ++j) h.push_back(AltitudeWhere(tau_of, tau_base[i] + dtau[i] * j / m, base[i], base[i + 1]));
     h.push_back(base[i + 1]);
   }
   return h;
