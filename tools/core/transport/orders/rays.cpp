@@ -175,8 +175,8 @@ std::vector<Family> BuildFamilies(const AtmosphereModel& m, const Medium& md, co
   return fam;
 }
 
-SunAzimuth StepSunAzimuth(const Nodes& nodes, bool even, const Family& f, size_t m, double r, double ts, double nu) {
-  const double mus = ClampCosine(SunMuAt(r, std::cos(ts), nu, f.t[m], f.r[m]));
+SunAzimuth StepSunAzimuth(const Nodes& nodes, bool even, const Family& f, size_t m, double r, double cos_ts, double nu) {
+  const double mus = ClampCosine(SunMuAt(r, cos_ts, nu, f.t[m], f.r[m]));
   const double mu2 = f.mu[m];
   const double denom = std::sqrt(std::max(1e-12, (1.0 - mu2 * mu2) * (1.0 - mus * mus)));
   return nodes.SunAzimuthAt(std::acos(mus), (nu - mu2 * mus) / denom, even);

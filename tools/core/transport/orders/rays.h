@@ -34,7 +34,7 @@ struct Family {
 std::vector<Family> BuildFamilies(const AtmosphereModel& m, const Medium& md, const Nodes& nodes, const OrdersSettings& s);
 
 // The sun/azimuth interpolation position of step m of family f for the cell at radius r, sun
-// zenith ts and scattering cosine nu (the sun's direction in the step's local frame).
-SunAzimuth StepSunAzimuth(const Nodes& nodes, bool even, const Family& f, size_t m, double r, double ts, double nu);
+// zenith cosine cos_ts and scattering cosine nu (the sun's direction in the step's local frame).
+SunAzimuth StepSunAzimuth(const Nodes& nodes, bool even, const Family& f, size_t m, double r, double cos_ts, double nu);
 
 }  // namespace skybake::orders

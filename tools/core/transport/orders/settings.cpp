@@ -77,6 +77,7 @@ const std::vector<OrdersOverride>& OrdersOverrides() {
       {"split_width_x10", K::kScaled, 1, 200, 10.0, &S::split_width_deg},
       {"split_day_to_deg", K::kScaled, 0, 180, 1.0, &S::split_day_to_deg},
       {"split_twilight_from_deg", K::kScaled, 0, 180, 1.0, &S::split_twilight_from_deg},
+      {"step_positions_mib", K::kCount, 0, kMany, 1.0, &S::step_positions_mib},
   };
   return overrides;
 }

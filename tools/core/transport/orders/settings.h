@@ -74,6 +74,10 @@ struct OrdersSettings {
   int ss_scaled_view = 1;
   // Largest share of the total the geometric tail may have when taken early (StopRule in solve.cpp).
   double tail_share_max = 0.1;
+  // Memory for the step positions stored between orders (TransportContext::sun_az, MiB): the
+  // radius nodes whose positions fit are stored, the others' computed per lookup, with the same
+  // bytes ("Peak memory" in docs/sky-methods.md).
+  int step_positions_mib = 256;
   int max_orders = 40;
   double tolerance = 1e-3;
   // The sun zenith nodes' spacing (SunNodes in settings.cpp): every sun_step_deg up to 80 deg,

@@ -18,7 +18,7 @@ namespace {
 
 // Order 1 of the scaled problem at every cell into L: the sun's light scattered once along each
 // table ray (P*, T* from the scaled sun table) and the ground's reflection of the direct sun;
-// fills tc->sun_az on the way.
+// fills tc->sun_az (the radius nodes it stores) on the way.
 void FirstOrder(const AtmosphereModel& m, const Medium& md, const SunTables& sun, TransportContext* tc, Table* L) {
   const Nodes& nodes = *tc->nodes;
   const size_t nw = md.nw, nc = md.nc, ns = nodes.ns, nu = nodes.nu, nr = nodes.radius.size();
@@ -53,7 +53,7 @@ void FirstOrder(const AtmosphereModel& m, const Medium& md, const SunTables& sun
         }
         std::fill(acc.begin(), acc.end(), 0.0f);
         for (size_t st = 0; st < f.t.size(); ++st) {
-          const double mus = (r * std::cos(ts) + f.t[st] * nu_s) / f.r[st];
+          const double mus = (r * tc->cos_sun[si] + f.t[st] * nu_s) / f.r[st];
           sun.Transmittance(f.r[st], mus, true, tsun.data());
           std::fill(src.begin(), src.end(), 0.0f);
           for (size_t c = 0; c < nc; ++c) {
@@ -61,8 +61,9 @@ void FirstOrder(const AtmosphereModel& m, const Medium& md, const SunTables& sun
             for (size_t w = 0; w < nw; ++w) src[w] += sv[w] * pc[c * nw + w];
           }
           for (size_t w = 0; w < nw; ++w) acc[w] += f.wt[st * nw + w] * src[w] * tsun[w] * static_cast<float>(md.sun_e[w]);
-          if (!tc->sun_az.empty()) {
-            tc->sun_az[nodes.Cell(ri, si, k, q) * nt + st] = PackSunAzimuth(StepSunAzimuth(nodes, tc->s->azimuth_even, f, st, r, ts, nu_s));
+          if (tc->Stored(ri)) {
+            tc->sun_az[nodes.Cell(ri, si, k, q) * nt + st] =
+                PackSunAzimuth(StepSunAzimuth(nodes, tc->s->azimuth_even, f, st, r, tc->cos_sun[si], nu_s));
           }
         }
         if (f.ground) AddGroundReflection(nodes, md, f, r, ts, nu_s, E0, eg.data(), acc.data());

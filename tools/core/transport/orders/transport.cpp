@@ -15,8 +15,10 @@ TransportContext MakeTransportContext(const AtmosphereModel& m, const Medium& md
   TransportContext tc;
   tc.m = &m, tc.md = &md, tc.nodes = &nodes, tc.s = &s, tc.fam = &fam;
   tc.nd = nodes.nu * static_cast<size_t>(s.nphi);
-  const size_t cells = nodes.radius.size() * nodes.ns * tc.nd, nt = static_cast<size_t>(s.nt);
-  if (cells * nt * sizeof(PackedSunAzimuth) <= (size_t{768} << 20)) tc.sun_az.resize(cells * nt);
+  const size_t per_radius = nodes.ns * tc.nd * static_cast<size_t>(s.nt);  // positions per radius node
+  tc.stored_radii = std::min(nodes.radius.size(), (static_cast<size_t>(s.step_positions_mib) << 20) / (per_radius * sizeof(PackedSunAzimuth)));
+  tc.sun_az.resize(tc.stored_radii * per_radius);
+  for (double ts : nodes.sun_theta_rad) tc.cos_sun.push_back(std::cos(ts));
   tc.loglin_first = nodes.ns;
   for (size_t si = 0; si + 1 < nodes.ns; ++si) {
     if (s.sun_deg[si] >= s.loglin_from_deg - 1e-9) {
@@ -27,11 +29,9 @@ TransportContext MakeTransportContext(const AtmosphereModel& m, const Medium& md
   return tc;
 }
 
-SunAzimuth TransportContext::StepPosition(const Family& f, size_t step, size_t ri, size_t si, size_t k, size_t q) const {
-  if (!sun_az.empty()) return UnpackSunAzimuth(sun_az[nodes->Cell(ri, si, k, q) * static_cast<size_t>(s->nt) + step]);
-  double mu, nu;
-  nodes->CellGeometry(ri, si, k, q, &mu, &nu);
-  return UnpackSunAzimuth(PackSunAzimuth(StepSunAzimuth(*nodes, s->azimuth_even, f, step, nodes->radius[ri], nodes->sun_theta_rad[si], nu)));
+SunAzimuth TransportContext::StepPosition(const Family& f, size_t step, size_t ri, size_t si, size_t k, size_t q, double nu_s) const {
+  if (Stored(ri)) return UnpackSunAzimuth(sun_az[nodes->Cell(ri, si, k, q) * static_cast<size_t>(s->nt) + step]);
+  return UnpackSunAzimuth(PackSunAzimuth(StepSunAzimuth(*nodes, s->azimuth_even, f, step, nodes->radius[ri], cos_sun[si], nu_s)));
 }
 
 void GroundIrradiance(const Nodes& nodes, int ndn, const Table& L, std::vector<float>* E) {
@@ -130,7 +130,7 @@ void TransportCells(const TransportContext& tc, const Table& Jin, const Table& L
         nodes.CellGeometry(ri, si, k, q, &mu, &nu_s);
         std::fill(acc.begin(), acc.end(), 0.0f);
         for (size_t m = 0; m < f.t.size(); ++m) {
-          const SunAzimuth p = tc.StepPosition(f, m, ri, si, k, q);
+          const SunAzimuth p = tc.StepPosition(f, m, ri, si, k, q, nu_s);
           if (p.si == kNoSun) continue;
           const size_t so = (static_cast<size_t>(p.si) * nu) * nphi + p.q0;
           float ws[4];

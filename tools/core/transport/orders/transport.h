@@ -42,16 +42,22 @@ struct TransportContext {
   const Nodes* nodes = nullptr;
   const OrdersSettings* s = nullptr;
   const std::vector<Family>* fam = nullptr;
-  // The sun/azimuth interpolation position of every (cell, step), [Cell * nt + step], shared by
-  // all orders (saves two acos and a node search per lookup and order; order 1 fills it); empty
-  // (computed per lookup) if it would take more than 768 MiB.
+  // The sun/azimuth interpolation position of every (cell, step) of the first stored_radii radius
+  // nodes, [Cell * nt + step], shared by all orders (saves two acos and a node search per lookup
+  // and order; order 1 fills it); the other radius nodes' positions are computed per lookup. As
+  // many radius nodes as fit in OrdersSettings::step_positions_mib.
   std::vector<PackedSunAzimuth> sun_az;
-  size_t loglin_first = 0;  // the first sun interval blended log-linearly (ns: none)
-  size_t nd = 0;            // directions per (radius, sun)
+  size_t stored_radii = 0;
+  std::vector<double> cos_sun;  // cos of each sun node's zenith angle
+  size_t loglin_first = 0;      // the first sun interval blended log-linearly (ns: none)
+  size_t nd = 0;                // directions per (radius, sun)
 
-  // Cell (ri, si, k, q)'s position at step `step` of family f.
-  SunAzimuth StepPosition(const Family& f, size_t step, size_t ri, size_t si, size_t k, size_t q) const;
+  bool Stored(size_t ri) const { return ri < stored_radii; }
+  // Cell (ri, si, k, q)'s position at step `step` of family f; nu_s: the cell's scattering
+  // cosine (Nodes::CellGeometry).
+  SunAzimuth StepPosition(const Family& f, size_t step, size_t ri, size_t si, size_t k, size_t q, double nu_s) const;
 };
+
 
 TransportContext MakeTransportContext(const AtmosphereModel& m, const Medium& md, const Nodes& nodes, const OrdersSettings& s,
                                       const std::vector<Family>& fam);

@@ -19,13 +19,24 @@ namespace {
 
 // One family's working set: slab[(s * nphi + q) * nw + w], the sum over the 4 radius/view
 // corners; lo / hi: the lower and the upper radius's 2 corners apart (twilight's log-linear
-// factor), for s >= loglin_first; acc: the family's cells; pts: their positions at a step.
+// factor), for s >= loglin_first; acc: the family's cells; pts: their positions at a step; nu:
+// their scattering cosines.
 struct FamilyScratch {
   std::vector<float> slab, lo, hi, acc, jv, jv2, eg;
   std::vector<SunAzimuth> pts;
+  std::vector<double> nu;
   FamilyScratch(size_t plane, size_t nw)
-      : slab(plane * nw), lo(plane * nw), hi(plane * nw), acc(plane * nw), jv(nw), jv2(nw), eg(nw), pts(plane) {}
+      : slab(plane * nw), lo(plane * nw), hi(plane * nw), acc(plane * nw), jv(nw), jv2(nw), eg(nw), pts(plane), nu(plane) {}
 };
+
+// The scattering cosines of the family's cells, for the positions computed per step.
+void FamilyGeometry(const TransportContext& tc, size_t ri, size_t k, FamilyScratch* x) {
+  const size_t ns = tc.nodes->ns, nphi = static_cast<size_t>(tc.nodes->nphi);
+  double mu;
+  for (size_t si = 0; si < ns; ++si) {
+    for (size_t q = 0; q < nphi; ++q) tc.nodes->CellGeometry(ri, si, k, q, &mu, &x->nu[si * nphi + q]);
+  }
+}
 
 // The cells' sun/azimuth positions at step m into x->pts, and the sun nodes [*s_lo, *s_hi] they read.
 void StepPositions(const TransportContext& tc, const Family& f, size_t m, size_t ri, size_t k, FamilyScratch* x, size_t* s_lo,
@@ -34,7 +45,7 @@ void StepPositions(const TransportContext& tc, const Family& f, size_t m, size_t
   *s_lo = ns, *s_hi = 0;
   for (size_t si = 0; si < ns; ++si) {
     for (size_t q = 0; q < nphi; ++q) {
-      const SunAzimuth p = tc.StepPosition(f, m, ri, si, k, q);
+      const SunAzimuth p = tc.StepPosition(f, m, ri, si, k, q, x->nu[si * nphi + q]);
       x->pts[si * nphi + q] = p;
       if (p.si == kNoSun) continue;
       *s_lo = std::min<size_t>(*s_lo, p.si);
@@ -124,6 +135,7 @@ void TransportSplit(const TransportContext& tc, const Table& Jin, const Table& L
       const size_t ri = fi / nu, k = fi % nu;
       const Family& f = (*tc.fam)[fi];
       std::fill(x.acc.begin(), x.acc.end(), 0.0f);
+      if (!tc.Stored(ri)) FamilyGeometry(tc, ri, k, &x);
       for (size_t m = 0; m < f.t.size(); ++m) {
         size_t s_lo, s_hi;
         StepPositions(tc, f, m, ri, k, &x, &s_lo, &s_hi);
