@@ -109,7 +109,7 @@ int main(int argc, char** argv) {
       const std::string path = ref.same_scene ? fmt::format("{:.2f} % ({:.2f})", 100.0 * std::sqrt(std::max(0.0, sp - noise) / n), 100.0 * mp)
                                               : std::string("-");
       std::printf("%-40s %6s %8.0f  %-22s %-22s\n", c.empty() ? "(high)" : c.c_str(), s.nodes.c_str(), s.seconds,
-                  fmt::format("{:.2f} % ({:.2f})", 100.0 * std::sqrt(ss / n), 100.0 * mx).c_str(), path.c_str());
+                  fmt::format("{:.3f} % ({:.3f})", 100.0 * std::sqrt(ss / n), 100.0 * mx).c_str(), path.c_str());
     }
   });
 }

@@ -20,6 +20,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include "transport/orders/half.h"
 #include "transport/orders/kernel.h"
 #include "transport/orders/simd.h"
 
@@ -103,9 +104,10 @@ void CoefficientsOfBasis(const KernelContext& kc, double r, const ViewNodes& vn,
   });
 }
 
-// G (and D, if not null) at radius node ri from the coefficients, with every row scaled to sum to
-// sigma_s* (energy conservation, as the matrix's rows: a row's sum is sum_k2 sum_d c(d), the same
-// for every azimuth; the end columns add nothing).
+// G (and D, if not null) at radius node ri from the coefficients, per unit sigma_s*, with every
+// row scaled to sum to 1 (energy conservation, as the matrix's rows sum to sigma_s*: a row's sum is
+// sum_k2 sum_d c(d), the same for every azimuth; the end columns add nothing). Without scattering
+// (sigma_s* = 0) the row is 0.
 void ModesFromCoefficients(const KernelContext& kc, size_t ri, const std::vector<double>& c, const std::vector<double>& dc, float* G,
                            float* D) {
   const OrdersSettings& s = *kc.s;
@@ -123,7 +125,10 @@ void ModesFromCoefficients(const KernelContext& kc, size_t ri, const std::vector
         for (size_t w = 0; w < nw; ++w) scale[w] += cv[w];
       }
     }
-    for (size_t w = 0; w < nw; ++w) scale[w] = s.normalise && scale[w] > 0.0 ? kc.ssc_total[ri * nw + w] / scale[w] : 1.0;
+    for (size_t w = 0; w < nw; ++w) {
+      const double st = kc.ssc_total[ri * nw + w];
+      scale[w] = !(st > 0.0) ? 0.0 : s.normalise && scale[w] > 0.0 ? 1.0 / scale[w] : 1.0 / st;
+    }
     for (size_t m = 0; m < nm; ++m) {
       const double f = (m == 0 ? 1.0 : 2.0) / s.nphi;
       for (size_t k2 = 0; k2 < nu; ++k2) {
@@ -151,11 +156,13 @@ void ModesFromCoefficients(const KernelContext& kc, size_t ri, const std::vector
 // A thread's double coefficients of one radius (54 MB for high): zeroed anew for each radius in
 // memory the thread keeps, not allocated per radius (fresh pages of that size cost a page fault
 // each and are zeroed by the kernel before the vector zeroes them again).
+// G and D of one radius as floats, before they are stored.
 struct CoefficientScratch {
   std::vector<double> c, dc;
+  std::vector<float> g, d;
 };
 
-void BuildModalKernel(const KernelContext& kc, const ScatterKernels& sk, size_t ri, float* G, float* D, CoefficientScratch* x) {
+void BuildModalKernel(const KernelContext& kc, ScatterKernels* sk, size_t ri, CoefficientScratch* x) {
   const size_t nw = kc.md->nw, nu = kc.nodes->nu, N = 2 * static_cast<size_t>(kc.s->nphi);
   const double r = kc.nodes->radius[ri];
   const std::vector<float> mix = kc.Mixture(ri);
@@ -163,10 +170,20 @@ void BuildModalKernel(const KernelContext& kc, const ScatterKernels& sk, size_t 
   std::vector<double>& c = x->c;  // c[((k * nu + k2) * N + d) * nw + w]
   std::vector<double>& dc = x->dc;
   c.assign(nu * nu * N * nw, 0.0);
-  dc.assign(sk.end_floats, 0.0);
+  dc.assign(sk->end_floats, 0.0);
+  x->g.resize(sk->modal_floats);
+  x->d.resize(sk->end_floats);
   if (kc.s->kernel_sub == 0) CoefficientsAtNodes(kc, vn, mix, &c);
-  else CoefficientsOfBasis(kc, r, vn, mix, sk.has_ends, &c, &dc);
-  ModesFromCoefficients(kc, ri, c, dc, G, D);
+  else CoefficientsOfBasis(kc, r, vn, mix, sk->has_ends, &c, &dc);
+  ModesFromCoefficients(kc, ri, c, dc, x->g.data(), sk->has_ends ? x->d.data() : nullptr);
+  const size_t g0 = ri * sk->modal_floats, d0 = ri * sk->end_floats;
+  if (sk->half) {
+    for (size_t i = 0; i < x->g.size(); ++i) sk->modal_half[g0 + i] = HalfFromFloat(x->g[i]);
+    for (size_t i = 0; i < x->d.size(); ++i) sk->end_half[d0 + i] = HalfFromFloat(x->d[i]);
+  } else {
+    std::copy(x->g.begin(), x->g.end(), sk->modal_kernels.begin() + static_cast<std::ptrdiff_t>(g0));
+    std::copy(x->d.begin(), x->d.end(), sk->end_kernels.begin() + static_cast<std::ptrdiff_t>(d0));
+  }
 }
 
 }  // namespace
@@ -182,15 +199,20 @@ void BuildModalKernels(const KernelContext& kc, ScatterKernels* sk) {
   sk->has_ends = s.kernel_sub > 0 && s.azimuth_even;
   sk->modal_floats = sk->nm * nu * nu * nw;
   sk->end_floats = sk->has_ends ? nu * nphi * nu * nw : 0;
-  ZeroTable(&sk->modal_kernels, nr * sk->modal_floats);
-  ZeroTable(&sk->end_kernels, nr * sk->end_floats);
+  sk->half = s.kernel_half;
+  if (sk->half) {
+    sk->modal_half.resize(nr * sk->modal_floats);
+    sk->end_half.resize(nr * sk->end_floats);
+  } else {
+    ZeroTable(&sk->modal_kernels, nr * sk->modal_floats);
+    ZeroTable(&sk->end_kernels, nr * sk->end_floats);
+  }
   {
     tbb::enumerable_thread_specific<CoefficientScratch> scratch;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, nr, 1), [&](const tbb::blocked_range<size_t>& rg) {
       CoefficientScratch& x = scratch.local();
       for (size_t ri = rg.begin(); ri != rg.end(); ++ri) {
-        BuildModalKernel(kc, *sk, ri, &sk->modal_kernels[ri * sk->modal_floats], sk->has_ends ? &sk->end_kernels[ri * sk->end_floats] : nullptr,
-                         &x);
+        BuildModalKernel(kc, sk, ri, &x);
       }
     });
   }  // the scratch is freed before the solve's tables are allocated (the peak, docs/sky-methods.md "Peak memory")
@@ -203,7 +225,9 @@ void BuildModalKernels(const KernelContext& kc, ScatterKernels* sk) {
 // within a task each G or D slice (nu nw floats) serves the 4 sub-blocks of 4 sun nodes while in
 // L1 (with tasks of 4 sun nodes high's scatter is bound by reading G once and D twice, 27 MB per
 // radius, 11 times per order).
-void ScatterModal(const KernelContext& kc, const ScatterKernels& sk, const Table& Lin, Table* Jout) {
+// K: the kernels' storage, float or binary16 (uint16_t).
+template <class K>
+void ScatterModalAs(const KernelContext& kc, const ScatterKernels& sk, const K* Gall, const K* Dall, const Table& Lin, Table* Jout) {
   const size_t nw = kc.md->nw, nu = kc.nodes->nu, ns = kc.nodes->ns, nphi = static_cast<size_t>(kc.s->nphi);
   const size_t nr = kc.nodes->radius.size(), nd = kc.nd, nm = sk.nm;
   const bool has_ends = sk.has_ends;
@@ -219,7 +243,7 @@ void ScatterModal(const KernelContext& kc, const ScatterKernels& sk, const Table
     for (size_t idx = rg.begin(); idx != rg.end(); ++idx) {
       const size_t ri = idx / nsb, s0 = (idx % nsb) * kSunBlock, s1 = std::min(ns, s0 + kSunBlock), nb = s1 - s0;
       const size_t nsub = (nb + kSub - 1) / kSub;
-      const float* G = &sk.modal_kernels[ri * sk.modal_floats];
+      const K* G = &Gall[ri * sk.modal_floats];
       // Analysis: S[b][m][k2] = sum_q L(k2, q) cos(m theta_q); the end differences dL.
       for (size_t b = 0; b < nb; ++b) {
         const float* lin = &Lin[((ri * ns + s0 + b) * nd) * nw];
@@ -244,7 +268,7 @@ void ScatterModal(const KernelContext& kc, const ScatterKernels& sk, const Table
           }
         }
       }
-      // Synthesis, the end columns, and J stored per unit sigma_s* (kernel.h).
+      // Synthesis and the end columns: J per unit sigma_s*, as the kernels are (kernel.h).
       for (size_t k = 0; k < nu; ++k) {
         for (size_t q = 0; q < nphi; ++q) {
           for (size_t u = 0; u < nsub; ++u) {
@@ -252,23 +276,23 @@ void ScatterModal(const KernelContext& kc, const ScatterKernels& sk, const Table
             if (has_ends) {
               for (size_t e = 0; e < 2; ++e) {
                 const size_t qe = e == 0 ? q : nphi - 1 - q;
-                const float* Dv = &sk.end_kernels[ri * sk.end_floats + ((k * nphi + qe) * nu) * nw];
+                const K* Dv = &Dall[ri * sk.end_floats + ((k * nphi + qe) * nu) * nw];
                 ModalBlock4Add(Dv, nw, &dL[u * kSub * db + e * nu * nw], nw, db, nu, nw, acc.data());
               }
             }
             for (size_t b = 0; b < kSub && u * kSub + b < nb; ++b) {
-              float* jo = &(*Jout)[(((ri * ns + s0 + u * kSub + b) * nd) + k * nphi + q) * nw];
-              const float* a = &acc[b * nw];
-              for (size_t w = 0; w < nw; ++w) {
-                const double st = kc.ssc_total[ri * nw + w];
-                jo[w] = st > 0.0 ? static_cast<float>(a[w] / st) : 0.0f;
-              }
+              std::copy_n(&acc[b * nw], nw, &(*Jout)[(((ri * ns + s0 + u * kSub + b) * nd) + k * nphi + q) * nw]);
             }
           }
         }
       }
     }
   });
+}
+
+void ScatterModal(const KernelContext& kc, const ScatterKernels& sk, const Table& Lin, Table* Jout) {
+  if (sk.half) ScatterModalAs(kc, sk, sk.modal_half.data(), sk.end_half.data(), Lin, Jout);
+  else ScatterModalAs(kc, sk, sk.modal_kernels.data(), sk.end_kernels.data(), Lin, Jout);
 }
 
 }  // namespace skybake::orders

@@ -2,6 +2,12 @@
 
 #include <cstring>
 
+#if defined(__F16C__)
+#include <immintrin.h>
+#endif
+
+#include "transport/orders/half.h"
+
 namespace skybake::orders {
 
 namespace {
@@ -13,12 +19,25 @@ inline V8 LoadV8(const float* p) {
   return x;
 }
 inline void StoreV8(float* p, V8 x) { std::memcpy(p, &x, sizeof x); }
+// 8 binary16 values as floats (exact): vcvtph2ps where the build has F16C, else one by one.
+inline V8 LoadV8(const uint16_t* p) {
+  V8 x;
+#if defined(__F16C__)
+  const __m256 f = _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
+  std::memcpy(&x, &f, sizeof x);
+#else
+  for (int i = 0; i < 8; ++i) x[i] = FloatFromHalf(p[i]);
+#endif
+  return x;
+}
+inline float ValueOf(float v) { return v; }
+inline float ValueOf(uint16_t v) { return FloatFromHalf(v); }
 
 // acc[b * nw + w] (+)= sum_{j ascending < n} g_j x[b * b_stride + j * x_stride + w] for the 4 b of a
 // sun block, g_j = g[j * g_stride + w] (kScalar false: a row per j, loaded once for the 4 b) or
 // g[j * g_stride] (kScalar true: one weight per j).
-template <bool kAdd, bool kScalar>
-void ModalBlock4Impl(const float* g, size_t g_stride, const float* x, size_t x_stride, size_t b_stride, size_t n, size_t nw,
+template <bool kAdd, bool kScalar, class G>
+void ModalBlock4Impl(const G* g, size_t g_stride, const float* x, size_t x_stride, size_t b_stride, size_t n, size_t nw,
                      float* acc) {
   size_t w = 0;
   for (; w + 8 <= nw; w += 8) {
@@ -29,7 +48,7 @@ void ModalBlock4Impl(const float* g, size_t g_stride, const float* x, size_t x_s
     for (size_t j = 0; j < n; ++j) {
       V8 gv;
       if (kScalar) {
-        gv = V8{} + g[j * g_stride];  // the weight in every lane
+        gv = V8{} + ValueOf(g[j * g_stride]);  // the weight in every lane
       } else {
         gv = LoadV8(g + j * g_stride + w);
       }
@@ -47,7 +66,7 @@ void ModalBlock4Impl(const float* g, size_t g_stride, const float* x, size_t x_s
   for (; w < nw; ++w) {
     for (size_t b = 0; b < 4; ++b) {
       float a = kAdd ? acc[b * nw + w] : 0.0f;
-      for (size_t j = 0; j < n; ++j) a += g[j * g_stride + (kScalar ? 0 : w)] * x[b * b_stride + j * x_stride + w];
+      for (size_t j = 0; j < n; ++j) a += ValueOf(g[j * g_stride + (kScalar ? 0 : w)]) * x[b * b_stride + j * x_stride + w];
       acc[b * nw + w] = a;
     }
   }
@@ -112,6 +131,13 @@ void ModalBlock4(const float* g, size_t g_stride, const float* x, size_t x_strid
   ModalBlock4Impl<false, false>(g, g_stride, x, x_stride, b_stride, n, nw, acc);
 }
 void ModalBlock4Add(const float* g, size_t g_stride, const float* x, size_t x_stride, size_t b_stride, size_t n, size_t nw,
+                    float* acc) {
+  ModalBlock4Impl<true, false>(g, g_stride, x, x_stride, b_stride, n, nw, acc);
+}
+void ModalBlock4(const uint16_t* g, size_t g_stride, const float* x, size_t x_stride, size_t b_stride, size_t n, size_t nw, float* acc) {
+  ModalBlock4Impl<false, false>(g, g_stride, x, x_stride, b_stride, n, nw, acc);
+}
+void ModalBlock4Add(const uint16_t* g, size_t g_stride, const float* x, size_t x_stride, size_t b_stride, size_t n, size_t nw,
                     float* acc) {
   ModalBlock4Impl<true, false>(g, g_stride, x, x_stride, b_stride, n, nw, acc);
 }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 
 namespace skybake::orders {
 
@@ -19,6 +20,11 @@ void ModalAnalysis(const float* l, const float* cos_mq, size_t nm, size_t nq, si
 void ModalBlock4(const float* g, size_t g_stride, const float* x, size_t x_stride, size_t b_stride, size_t n, size_t nw, float* acc);
 // The same added to acc.
 void ModalBlock4Add(const float* g, size_t g_stride, const float* x, size_t x_stride, size_t b_stride, size_t n, size_t nw,
+                    float* acc);
+// The two with g stored as binary16 (half.h; converted exactly, so each sum rounds as with the
+// float g of the same values).
+void ModalBlock4(const uint16_t* g, size_t g_stride, const float* x, size_t x_stride, size_t b_stride, size_t n, size_t nw, float* acc);
+void ModalBlock4Add(const uint16_t* g, size_t g_stride, const float* x, size_t x_stride, size_t b_stride, size_t n, size_t nw,
                     float* acc);
 // acc[b * nw + w] = sum_{m ascending < nm} c[m * c_stride] t[b * b_stride + m * nw + w], 4 b.
 void ModalSynthesis4(const float* c, size_t c_stride, const float* t, size_t b_stride, size_t nm, size_t nw, float* acc);
