@@ -76,6 +76,7 @@ Nodes BuildNodes(const AtmosphereModel& m, const OrdersSettings& s, double obser
   }
   for (double d : s.sun_deg) n.sun_theta_rad.push_back(d * kDeg);
   n.ns = n.sun_theta_rad.size();
+  n.sun_loc = IntervalLocator(n.sun_theta_rad);
   n.nu = static_cast<size_t>(s.nup + s.ndn);
   return n;
 }
@@ -185,7 +186,7 @@ SunAzimuth Nodes::SunAzimuthAt(double theta_s, double cos_phi, bool even) const 
     sa.si = kNoSun;
     return sa;
   }
-  const Lerp ls = Locate(sun_theta_rad, theta_s);
+  const Lerp ls = Locate(sun_loc, theta_s);
   size_t q0;
   const double tq = AzimuthBlend(std::acos(std::clamp(cos_phi, -1.0, 1.0)), even, &q0);
   sa.si = static_cast<uint16_t>(ls.i);

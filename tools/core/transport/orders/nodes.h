@@ -40,6 +40,7 @@ struct Nodes {
   size_t obs_index = 0;
   size_t ns = 0, nu = 0;       // sun nodes, view nodes per radius
   std::vector<double> sun_theta_rad;
+  IntervalLocator sun_loc;  // over sun_theta_rad: SunAzimuthAt's lookup, once per table-ray step and cell
 
   double HorizonMu(double r) const;
   // View node k (0..nu-1, ascending mu) at radius r.
