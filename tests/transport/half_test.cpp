@@ -12,6 +12,7 @@
 #include "transport/orders/half.h"
 
 #if defined(__x86_64__)
+#include <cpuid.h>
 #include <immintrin.h>
 #endif
 
@@ -66,8 +67,8 @@ __attribute__((target("f16c"))) uint32_t FirstDifferenceFromF16c(uint32_t from, 
     float f;
     std::memcpy(&f, &x, sizeof f);
     for (const float v : {f, -f}) {
-      const uint16_t hw = static_cast<uint16_t>(_cvtss_sh(v, 0));
-      if (HalfFromFloat(v) != hw || FloatFromHalf(hw) != _cvtsh_ss(hw)) return x;
+      const uint16_t hw = static_cast<uint16_t>(_mm_cvtsi128_si32(_mm_cvtps_ph(_mm_set_ss(v), 0)) & 0xffff);
+      if (HalfFromFloat(v) != hw || FloatFromHalf(hw) != _mm_cvtss_f32(_mm_cvtph_ps(_mm_cvtsi32_si128(hw)))) return x;
     }
   }
   return to;
@@ -78,7 +79,8 @@ __attribute__((target("f16c"))) uint32_t FirstDifferenceFromF16c(uint32_t from, 
 // EveryHalfRoundTrips; its payload is not kept).
 TEST(Half, SameBitsAsTheHardwareConversion) {
 #if defined(__x86_64__)
-  if (!__builtin_cpu_supports("f16c")) GTEST_SKIP() << "no F16C on this machine";
+  unsigned a = 0, b = 0, c = 0, d = 0;
+  if (!__get_cpuid(1, &a, &b, &c, &d) || !(c & bit_F16C)) GTEST_SKIP() << "no F16C on this machine";
   EXPECT_EQ(FirstDifferenceFromF16c(0x30000000u, 0x48000000u), 0x48000000u);
   EXPECT_EQ(FirstDifferenceFromF16c(0x7f800000u, 0x7f800001u), 0x7f800001u);
 #else
