@@ -60,8 +60,8 @@ struct ScatterKernels {
   size_t modal_floats = 0;     // G[((m * nu + k) * nu + k2) * nw + w] per radius
   size_t end_floats = 0;       // D[((k * nphi + q) * nu + k2) * nw + w] per radius (both ends: modal_kernel.cpp)
   // G and D per unit sigma_s* (J / sigma_s* comes out of the products): floats, or binary16
-  // (OrdersSettings::kernel_half; the half's 11 significant bits are relative to the kernel's
-  // scale, which the coefficients in m^-1 would put among the half's subnormals).
+  // (OrdersSettings::kernel_half). Per unit sigma_s* the values are 1e-5..1, normal halves; in
+  // m^-1 they would fall among the half's subnormals.
   bool half = false;
   Table modal_kernels, end_kernels;
   std::vector<uint16_t> modal_half, end_half;

@@ -153,10 +153,10 @@ void ModesFromCoefficients(const KernelContext& kc, size_t ri, const std::vector
   }
 }
 
-// A thread's double coefficients of one radius (54 MB for high): zeroed anew for each radius in
+// A thread's double coefficients of one radius (54 MB for high), zeroed anew for each radius in
 // memory the thread keeps, not allocated per radius (fresh pages of that size cost a page fault
-// each and are zeroed by the kernel before the vector zeroes them again).
-// G and D of one radius as floats, before they are stored.
+// each and are zeroed by the kernel before the vector zeroes them again); and the radius's G and
+// D as floats before they are stored.
 struct CoefficientScratch {
   std::vector<double> c, dc;
   std::vector<float> g, d;
@@ -220,12 +220,12 @@ void BuildModalKernels(const KernelContext& kc, ScatterKernels* sk) {
 
 // The three products run 8 wavelengths wide (simd.h), each sum in the order of the plain loops
 // (analysis: q ascending; modes: k2 ascending; synthesis: m ascending, then the end columns e, k2
-// ascending). Tasks (radius, block of up to 16 sun nodes): G (nm nu^2 nw floats per radius, 9 MB
-// for high) and D (as much, read once per end) do not fit in cache and are read once per task;
-// within a task each G or D slice (nu nw floats) serves the 4 sub-blocks of 4 sun nodes while in
-// L1 (with tasks of 4 sun nodes high's scatter is bound by reading G once and D twice, 27 MB per
-// radius, 11 times per order).
-// K: the kernels' storage, float or binary16 (uint16_t).
+// ascending). Tasks (radius, block of up to 16 sun nodes): G (nm nu^2 nw values per radius, 4.5 MB
+// as binary16 for high at 48 wavelengths) and D (as much, read once per end) do not fit in cache
+// and are read once per task; within a task each G or D slice (nu nw values) serves the 4
+// sub-blocks of 4 sun nodes while in L1 (with tasks of 4 sun nodes high's scatter is bound by
+// reading G once and D twice, 11 times per order). K: the kernels' storage, float or binary16
+// (uint16_t).
 template <class K>
 void ScatterModalAs(const KernelContext& kc, const ScatterKernels& sk, const K* Gall, const K* Dall, const Table& Lin, Table* Jout) {
   const size_t nw = kc.md->nw, nu = kc.nodes->nu, ns = kc.nodes->ns, nphi = static_cast<size_t>(kc.s->nphi);

@@ -57,8 +57,9 @@ struct OrdersSettings {
   // against ("Scattering kernel" in docs/sky-methods.md).
   bool kernel_modal = true;
   // The modal kernels stored as IEEE binary16 (half.h) per unit sigma_s*: half the memory and
-  // half the bytes each order's scatter reads, within 1e-4 of the float kernels (the sky within
-  // 0.005 % RMS; "Scattering kernel" in docs/sky-methods.md); false: floats.
+  // half the bytes each order's scatter reads; each value within 2^-12 of the float one, the sky
+  // within 0.003 % of the float kernels' at high ("Scattering kernel" in docs/sky-methods.md);
+  // false: floats.
   bool kernel_half = true;
   // The transport's gather by families (radius/view corners blended once per step for all sun and
   // azimuth nodes); false: cell by cell, 16 corners each (the plain form).

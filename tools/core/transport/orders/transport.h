@@ -58,7 +58,6 @@ struct TransportContext {
   SunAzimuth StepPosition(const Family& f, size_t step, size_t ri, size_t si, size_t k, size_t q, double nu_s) const;
 };
 
-
 TransportContext MakeTransportContext(const AtmosphereModel& m, const Medium& md, const Nodes& nodes, const OrdersSettings& s,
                                       const std::vector<Family>& fam);
 
