@@ -15,6 +15,7 @@
 #include "io/error.h"
 #include "method_scenes.h"
 #include "transport/method_orders.h"
+#include "transport/view_segment.h"
 
 using namespace skybake;
 using namespace skybake::testing;
@@ -427,6 +428,40 @@ TEST(MethodOrders, StoredAndComputedStepPositionsAreTheSameSky) {
   for (size_t i = 0; i < all.size(); ++i) {
     ASSERT_EQ(all[i], some[i]) << i;
     ASSERT_EQ(all[i], none[i]) << i;
+  }
+}
+
+// The solve in wavelength batches (solve.h: each batch also solves the reference wavelength, whose
+// decisions every batch shares) against one solve: the same bytes for the sky, daylight and
+// twilight, and for a view segment, which reads the sources J_ms. low hazed, 21 wavelengths, its
+// tables 0.75 MiB per wavelength: a budget of 6 MiB gives three batches of 8, 8 and 7 solved
+// (the reference, the middle one, in each), 1 MiB the smallest batches, 20 (one wavelength and
+// the reference; the reference's batch two of its own).
+TEST(MethodOrders, WavelengthBatchesAreTheSameSky) {
+  const TestScene sc = LoadTestScene("hazed");
+  ViewSegment seg;
+  seg.max_distance_m = 20e3;
+  auto sky = [&](int mib, const std::string& batches) {
+    SkyMethodOptions o;
+    o.quality = Quality::kLow;
+    o.segments = true;
+    if (mib > 0) o.table_size["solve_tables_mib"] = mib;
+    const std::unique_ptr<SkyMethod> m = MakeSkyMethod("orders", sc.model, o, {});
+    EXPECT_NE(m->Describe().find("wavelength_batches: " + batches + "\n"), std::string::npos) << m->Describe();
+    std::vector<double> y, more;
+    m->Radiance(1.0, 60.0 * kDeg, SkyDirs(), &y);
+    m->Radiance(1.0, 95.0 * kDeg, SkyDirs(), &more);
+    y.insert(y.end(), more.begin(), more.end());
+    m->SegmentRadiance(1.0, 60.0 * kDeg, SkyDirs(), seg, &more);
+    y.insert(y.end(), more.begin(), more.end());
+    return y;
+  };
+  const std::vector<double> one = sky(0, "1"), three = sky(6, "3"), each = sky(1, "20");
+  ASSERT_EQ(one.size(), 3 * SkyDirs().size() * sc.model.wavelengths());
+  ASSERT_EQ(one.size(), each.size());
+  for (size_t i = 0; i < one.size(); ++i) {
+    ASSERT_EQ(one[i], three[i]) << i;
+    ASSERT_EQ(one[i], each[i]) << i;
   }
 }
 

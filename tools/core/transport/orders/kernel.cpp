@@ -238,6 +238,13 @@ ScatterKernels BuildScatterKernels(const KernelContext& kc) {
   return sk;
 }
 
+size_t KernelBytesPerWavelength(const Nodes& nodes, const OrdersSettings& s) {
+  const size_t nr = nodes.radius.size(), nu = nodes.nu, nphi = static_cast<size_t>(s.nphi), nd = nu * nphi;
+  if (!s.kernel_modal) return nr * nd * nd * sizeof(float);
+  const size_t values = nphi * nu * nu + (s.kernel_sub > 0 && s.azimuth_even ? nu * nphi * nu : 0);  // G, D (BuildModalKernels)
+  return nr * values * (s.kernel_half ? sizeof(uint16_t) : sizeof(float));
+}
+
 void Scatter(const KernelContext& kc, const ScatterKernels& sk, const Table& Lin, Table* Jout) {
   if (sk.modal) ScatterModal(kc, sk, Lin, Jout);
   else ScatterMatrix(kc, sk, Lin, Jout);

@@ -70,6 +70,9 @@ struct ScatterKernels {
 };
 
 ScatterKernels BuildScatterKernels(const KernelContext& kc);
+// What BuildScatterKernels holds per wavelength (bytes, all radius nodes): the modal G and D, or
+// the matrices.
+size_t KernelBytesPerWavelength(const Nodes& nodes, const OrdersSettings& s);
 // Jout = the scattering of Lin (cells x nw each), per unit sigma_s*.
 void Scatter(const KernelContext& kc, const ScatterKernels& sk, const Table& Lin, Table* Jout);
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -118,6 +119,7 @@ Medium PrepareMedium(const AtmosphereModel& m, const OrdersSettings& s, bool ss_
   Medium md;
   md.m = &m;
   md.nw = m.wavelengths();
+  md.wref = md.nw / 2;
   for (const MediumComponent& c : m.components) {
     if (c.phase) md.phase.push_back(c.phase);
   }
@@ -128,6 +130,33 @@ Medium PrepareMedium(const AtmosphereModel& m, const OrdersSettings& s, bool ss_
   TruncatePhases(&md);
   FillCoefficients(m, s, ss_scaled_view, &md);
   return md;
+}
+
+Medium SliceMedium(const Medium& md, const std::vector<size_t>& ws) {
+  Medium b = md;
+  const size_t nw = md.nw, nv = ws.size();
+  b.nw = nv;
+  b.wref = static_cast<size_t>(std::find(ws.begin(), ws.end(), md.wref) - ws.begin());
+  if (b.wref == nv) throw std::logic_error("orders: a wavelength batch without the reference wavelength");
+  // Every table here is [outer * nw + w]: keep the columns ws of each row.
+  auto slice = [&](const auto& v, auto* out) {
+    const size_t rows = v.size() / nw;
+    out->resize(rows * nv);
+    for (size_t i = 0; i < rows; ++i) {
+      for (size_t j = 0; j < nv; ++j) (*out)[i * nv + j] = v[i * nw + ws[j]];
+    }
+  };
+  slice(md.sigma_t, &b.sigma_t);
+  slice(md.sigma_t_star, &b.sigma_t_star);
+  slice(md.sigma_s, &b.sigma_s);
+  slice(md.sigma_s_star, &b.sigma_s_star);
+  slice(md.sigma_t_view, &b.sigma_t_view);
+  slice(md.f, &b.f);
+  slice(md.phase_star, &b.phase_star);
+  slice(md.albedo, &b.albedo);
+  slice(md.sun_e, &b.sun_e);
+  b.phase.clear();  // indexed by the model's wavelengths: the render's, never a batch's
+  return b;
 }
 
 float Medium::SigmaTAt(double z, bool scaled, size_t w) const {

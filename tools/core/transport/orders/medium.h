@@ -16,6 +16,9 @@ namespace skybake::orders {
 struct Medium {
   const AtmosphereModel* m = nullptr;
   size_t nw = 0;
+  // The reference wavelength of the table rays' step placement and of the solve's stopping rule:
+  // the grid's middle one, at this index (a wavelength batch, SliceMedium, keeps it).
+  size_t wref = 0;
   size_t nc = 0;  // scattering components
   // Per model level l: sigma_t[l*nw+w], sigma_t*[..], sigma_s_c[(c*nl+l)*nw+w], sigma_s*_c.
   std::vector<float> sigma_t, sigma_t_star, sigma_s, sigma_s_star;
@@ -48,5 +51,10 @@ struct Medium {
 // The medium of model under settings s; ss_scaled_view: the view ray's attenuation delta-scaled
 // for the components OrdersSettings::ss_scaled_view selects.
 Medium PrepareMedium(const AtmosphereModel& model, const OrdersSettings& s, bool ss_scaled_view);
+
+// The medium at the wavelengths ws (indices into md's, ascending; md.wref among them), each value
+// copied, without the phase models (which take the model's wavelength index): a wavelength batch
+// of the solve (solve.h).
+Medium SliceMedium(const Medium& md, const std::vector<size_t>& ws);
 
 }  // namespace skybake::orders

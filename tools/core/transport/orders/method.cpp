@@ -26,6 +26,7 @@ class OrdersSolve {
     md_ = orders::PrepareMedium(m_, s_, ss_scaled_ && s_.ss_scaled_view > 0);
     sun_ = orders::BuildSunTables(m_, md_, s_);
     nodes_ = orders::BuildNodes(m_, s_, observer_altitude_m);
+    batches_ = orders::PlanWavelengthBatches(md_, nodes_, s_, segments).size();
     res_ = orders::SolveMultipleScattering(m_, md_, sun_, nodes_, s_, segments, progress);
   }
 
@@ -34,11 +35,13 @@ class OrdersSolve {
     return fmt::format(
         "{0}radius_nodes: {1}\n{0}view_nodes: {2} up + {3} down per altitude\n{0}azimuth_nodes: {4}\n"
         "{0}sun_nodes: {5}\n{0}ray_steps: {6}\n{0}view_steps: {7}\n{0}truncation_deg: {8}\n{0}kernel: {9}\n{0}orders_computed: {10}\n"
-        "{0}tail_extrapolated: {11}{15}\n{0}last_order_fraction: {12:.3g}\n{0}tolerance: {13}\n{0}single_scattering_attenuation: {14}\n",
+        "{0}tail_extrapolated: {11}{15}\n{0}last_order_fraction: {12:.3g}\n{0}tolerance: {13}\n{0}single_scattering_attenuation: {14}\n"
+        "{0}wavelength_batches: {16}\n",
         prefix, nodes_.radius.size(), s_.nup, s_.ndn, s_.nphi, SunNodesText(), s_.nt, s_.nss, md_.ConesText(),
         s_.kernel_sub > 0 ? fmt::format("basis-integrated, {} sub-intervals", s_.kernel_sub) : std::string("phase at the nodes"),
         res_.orders_done, res_.tail != orders::Tail::kNone ? "true" : "false", res_.last_fraction, s_.tolerance, ss_scaled_ ? "delta-scaled" : "unscaled",
-        res_.tail == orders::Tail::kDominant ? " (dominant mode)" : res_.tail == orders::Tail::kTwoModes ? " (two modes)" : "");
+        res_.tail == orders::Tail::kDominant ? " (dominant mode)" : res_.tail == orders::Tail::kTwoModes ? " (two modes)" : "",
+        batches_);
   }
 
   void Render(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,
@@ -65,6 +68,7 @@ class OrdersSolve {
   orders::Medium md_;
   orders::SunTables sun_;
   orders::Nodes nodes_;
+  size_t batches_ = 1;  // the solve's wavelength batches (solve.h)
   orders::SolveResult res_;
   mutable orders::ViewRayCache cache_;
 };

@@ -53,7 +53,7 @@ FineDepth FineDepthAlong(const AtmosphereModel& m, const Medium& md, const Order
   fd.d = d;
   fd.cum.assign(static_cast<size_t>(nf) + 1, 0.0);
   fd.cum_w.assign(static_cast<size_t>(nf) + 1, std::vector<float>(nw, 0.0f));
-  const size_t wref = nw / 2;
+  const size_t wref = md.wref;
   for (int p = 0; p < nf; ++p) {
     const double tm = (p + 0.5) * d / nf;
     const double rr = RadiusAt(r, mu, tm);
@@ -102,7 +102,7 @@ double StepPoint(const FineDepth& fd, double t0, double t1, size_t wref) {
 // without end; docs/sky-methods.md "Step weights"); where the step is optically empty, T*(t0) h.
 void AddStep(const AtmosphereModel& m, const Medium& md, const Nodes& nodes, const FineDepth& fd, double r, double mu, size_t step,
              size_t nt, std::vector<float>* st, std::vector<float>* sc, Family* f) {
-  const size_t nw = md.nw, wref = nw / 2;
+  const size_t nw = md.nw, wref = md.wref;
   const double R = m.bottom_radius_m;
   const double t0 = fd.TOfS(static_cast<double>(step) / nt), t1 = fd.TOfS(static_cast<double>(step + 1) / nt);
   const double h = t1 - t0;

@@ -19,7 +19,7 @@ class ViewStepper {
   ViewStepper(const Medium& md, int nf, double r, double mu, double length) : nf_(nf), length_(length), s_at_(static_cast<size_t>(nf) + 1) {
     const double R = md.m->bottom_radius_m;
     std::vector<double> cum(static_cast<size_t>(nf) + 1, 0.0);
-    const size_t wref = md.nw / 2;
+    const size_t wref = md.wref;
     for (int p = 0; p < nf; ++p) {
       const double tm = (p + 0.5) * length / nf;
       const double rr = RadiusAt(r, mu, tm);
@@ -275,7 +275,7 @@ void Render(const RenderInputs& in, double observer_altitude_m, double sun_zenit
   const double ts = sun_zenith_rad;
   out->assign(dirs.size() * nw, 0.0);
   if (single != nullptr) single->assign(dirs.size() * nw, 0.0);
-  const Lerp ls = Locate(in.nodes->sun_theta_rad, ts);
+  const Lerp ls = Locate(in.nodes->sun_loc, ts);
   DirectionScratch x(nw, in.md->nc);
   // Whole view rays are kept across calls (ViewRayCache); a segment's is built per view cosine.
   ViewRay local;

@@ -78,6 +78,7 @@ const std::vector<OrdersOverride>& OrdersOverrides() {
       {"split_day_to_deg", K::kScaled, 0, 180, 1.0, &S::split_day_to_deg},
       {"split_twilight_from_deg", K::kScaled, 0, 180, 1.0, &S::split_twilight_from_deg},
       {"step_positions_mib", K::kCount, 0, kMany, 1.0, &S::step_positions_mib},
+      {"solve_tables_mib", K::kCount, 1, kMany, 1.0, &S::solve_tables_mib},
       {"kernel_half", K::kFlag, 0, 1, 1.0, &S::kernel_half},
   };
   return overrides;

@@ -56,7 +56,7 @@ struct OrdersSettings {
   // columns); false: the (nd x nd) matrix, the slow and plain form the modal one is tested
   // against ("Scattering kernel" in docs/sky-methods.md).
   bool kernel_modal = true;
-  // The modal kernels stored as IEEE binary16 (half.h) per unit sigma_s*: half the memory and
+  // The modal kernels stored as IEEE binary16 (Imath's half, round to nearest even) per unit sigma_s*: half the memory and
   // half the bytes each order's scatter reads; each value within 2^-12 of the float one, the sky
   // within 0.003 % of the float kernels' at high ("Scattering kernel" in docs/sky-methods.md);
   // false: floats.
@@ -83,6 +83,10 @@ struct OrdersSettings {
   // radius nodes whose positions fit are stored, the others' computed per lookup, with the same
   // bytes ("Peak memory" in docs/sky-methods.md).
   int step_positions_mib = 256;
+  // Memory for the solve's per-wavelength tables (the fields, the ratio codes, the kernels, J_ms;
+  // MiB): above it the wavelengths are solved in batches that fit, with the same bytes
+  // (PlanWavelengthBatches in solve.h; "Peak memory" in docs/sky-methods.md).
+  int solve_tables_mib = 640;
   int max_orders = 40;
   double tolerance = 1e-3;
   // The sun zenith nodes' spacing (SunNodes in settings.cpp): every sun_step_deg up to 80 deg,

@@ -196,8 +196,8 @@ struct SecondMode {
   std::vector<double> lambda, mu;  // per wavelength
   double fraction = 1.0;           // sum |D_n| / ((1 - lambda) total) at the reference wavelength
 };
-SecondMode EstimateSecondMode(const Nodes& nodes, size_t nd, double ratio, const std::vector<double>& lambda, const Table& L,
-                              const Table& Lnext, const std::vector<float>& obs_before, double total) {
+SecondMode EstimateSecondMode(const Nodes& nodes, size_t nd, size_t wref, double ratio, const std::vector<double>& lambda,
+                              const Table& L, const Table& Lnext, const std::vector<float>& obs_before, double total) {
   const size_t nw = nodes.nw, n = nodes.ns * nd * nw, e0 = nodes.obs_index * n;
   SecondMode m;
   m.lambda = lambda;
@@ -209,7 +209,6 @@ SecondMode EstimateSecondMode(const Nodes& nodes, size_t nd, double ratio, const
   }
   m.mu.resize(nw);
   for (size_t w = 0; w < nw; ++w) m.mu[w] = dm[w] > 0.0 ? dn[w] / dm[w] : 0.0;
-  const size_t wref = nw / 2;
   if (total > 0.0 && ratio < 1.0) m.fraction = dn[wref] / ((1.0 - ratio) * total);
   return m;
 }
@@ -267,11 +266,11 @@ bool TakeTwoModes(const OrdersSettings& s, double fraction, double ratio, const 
   return RatioTailError(fraction, ratio, h) < s.tolerance && mu_error < s.tolerance;
 }
 
-// Adds L (order n) at the observer radius to ms; returns its norm at the reference wavelength,
-// sets *total to the accumulated one and norm_w to the norm at every wavelength.
-double AccumulateAtObserver(const Nodes& nodes, size_t nd, const Table& L, std::vector<float>* ms, double* total,
+// Adds L (order n) at the observer radius to ms; returns its norm at the reference wavelength
+// wref, sets *total to the accumulated one and norm_w to the norm at every wavelength.
+double AccumulateAtObserver(const Nodes& nodes, size_t nd, size_t wref, const Table& L, std::vector<float>* ms, double* total,
                             std::vector<double>* norm_w) {
-  const size_t nw = nodes.nw, ns = nodes.ns, wref = nw / 2;
+  const size_t nw = nodes.nw, ns = nodes.ns;
   double norm = 0.0;
   *total = 0.0;
   norm_w->assign(nw, 0.0);
@@ -292,8 +291,8 @@ double AccumulateAtObserver(const Nodes& nodes, size_t nd, const Table& L, std::
 
 }  // namespace
 
-SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, const SunTables& sun, const Nodes& nodes,
-                                    const OrdersSettings& s, bool keep_sources, const ProgressFn& progress) {
+SolveResult SolveOrders(const AtmosphereModel& m, const Medium& md, const SunTables& sun, const Nodes& nodes, const OrdersSettings& s,
+                        bool keep_sources, const ProgressFn& progress) {
   const size_t nw = md.nw, nr = nodes.radius.size(), nphi = static_cast<size_t>(s.nphi);
   const size_t cells = nr * nodes.ns * nodes.nu * nphi;
   const std::vector<Family> fam = BuildFamilies(m, md, nodes, s);
@@ -324,9 +323,10 @@ SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, 
       for (size_t i = rg.begin(); i != rg.end(); ++i) out.jms[i] += t.J[i];
     });
     Transport(tc, t.J, t.L, &t.Lnext);
-    // Accumulate L_n (Lnext) at the observer radius; convergence on the reference wavelength.
+    // Accumulate L_n (Lnext) at the observer radius; convergence on the reference wavelength
+    // (every decision below reads it, so a wavelength batch that holds it stops as the whole does).
     double total = 0.0;
-    const double norm = AccumulateAtObserver(nodes, nd, t.Lnext, &out.ms, &total, &norm_w);
+    const double norm = AccumulateAtObserver(nodes, nd, md.wref, t.Lnext, &out.ms, &total, &norm_w);
     out.orders_done = order;
     out.last_fraction = total > 0.0 ? norm / total : 0.0;
     const double ratio = h.prev_norm > 0.0 ? norm / h.prev_norm : -1.0;
@@ -338,8 +338,8 @@ SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, 
       break;
     }
     if (!obs_before.empty() && TwoModesApply(s, order, out.last_fraction, ratio, h)) {
-      const SecondMode sm = EstimateSecondMode(nodes, nd, ratio, ratio_w, t.L, t.Lnext, obs_before, total);
-      const double mu = sm.mu[nw / 2];
+      const SecondMode sm = EstimateSecondMode(nodes, nd, md.wref, ratio, ratio_w, t.L, t.Lnext, obs_before, total);
+      const double mu = sm.mu[md.wref];
       if (TakeTwoModes(s, out.last_fraction, ratio, h, mu, prev_mu, sm.fraction)) {
         AddTwoModeTail(kc, sk, nodes, s, nd, sm, &t, &out);
         break;

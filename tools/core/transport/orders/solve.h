@@ -34,7 +34,28 @@ struct SolveResult {
   double last_fraction = 0.0;
 };
 
-// keep_sources: accumulate jms (view segments need it; the sky alone reads ms).
+// One solve over every wavelength of md (sun and nodes at md's wavelengths); keep_sources:
+// accumulate jms (view segments need it; the sky alone reads ms).
+SolveResult SolveOrders(const AtmosphereModel& m, const Medium& md, const SunTables& sun, const Nodes& nodes, const OrdersSettings& s,
+                        bool keep_sources, const ProgressFn& progress);
+
+// The solve in wavelength batches (batches.cpp; docs/sky-methods.md "Peak memory"). The orders
+// do not mix wavelengths, so a batch of wavelengths can be solved on its own, with tables sized to
+// the batch: the solve's per-wavelength tables (the fields L, J and L_next, the ratio codes, the
+// kernels, J_ms) are what grows with the wavelengths, and a thick cloud's 65 radius nodes make
+// them 0.9 GB at 25 wavelengths. Each batch also solves the reference wavelength (Medium::wref),
+// which every decision of the solve reads - the step placement, the stopping rule, the tail - so
+// each batch takes the same steps and orders as the whole: the same bytes as one solve.
+struct WavelengthBatch {
+  std::vector<size_t> solve;  // the wavelengths solved (ascending; the reference among them)
+  size_t first = 0, end = 0;  // the batch's own wavelengths [first, end), which it answers for
+};
+// Batches of contiguous wavelengths whose tables fit in s.solve_tables_mib: one when all do, else
+// as many wavelengths solved per batch as fit, rounded down to a multiple of 8 (batches.cpp), and
+// at least 2 (one of them the reference).
+std::vector<WavelengthBatch> PlanWavelengthBatches(const Medium& md, const Nodes& nodes, const OrdersSettings& s, bool keep_sources);
+
+// SolveOrders over the batches of PlanWavelengthBatches, their results put together.
 SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, const SunTables& sun, const Nodes& nodes,
                                     const OrdersSettings& s, bool keep_sources, const ProgressFn& progress);
 

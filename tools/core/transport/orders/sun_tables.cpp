@@ -108,6 +108,8 @@ void AverageOverDisk(const std::vector<float>& base, const std::vector<Lerp>& di
       else tb->pos[n] = 0;
     }
   });
+  tb->first.resize(tb->pos.size());
+  for (size_t n = 0; n < tb->first.size(); ++n) tb->first[n] = tb->t[n * nw];
 }
 
 }  // namespace
@@ -160,6 +162,25 @@ SunTables BuildSunTables(const AtmosphereModel& m, const Medium& md, const Order
   return st;
 }
 
+SunTables SliceSunTables(const SunTables& sun, const std::vector<size_t>& ws) {
+  SunTables b = sun;
+  const size_t nw = sun.nw, nv = ws.size();
+  b.nw = nv;
+  for (SunTable* tb : {&b.plain, &b.star}) {
+    const SunTable& from = tb == &b.plain ? sun.plain : sun.star;
+    const size_t nodes = from.pos.size();
+    tb->t.resize(nodes * nv);
+    tb->lt.resize(nodes * nv);
+    for (size_t n = 0; n < nodes; ++n) {
+      for (size_t j = 0; j < nv; ++j) {
+        tb->t[n * nv + j] = from.t[n * nw + ws[j]];
+        tb->lt[n * nv + j] = from.lt[n * nw + ws[j]];
+      }
+    }
+  }
+  return b;
+}
+
 // Bilinear in (radius, sun zenith). The table blends the logarithm where the four nodes differ by
 // more than 2 % and are all lit: the transmittance is exponential in both (e^-tau, tau growing by
 // ~4 per km of descent through the hazed sky's aerosol with the sun 5 deg high), and a linear
@@ -182,8 +203,9 @@ void SunTables::TransmittanceAt(const Lerp& lr, double mu_s, bool scaled, float*
   const float w00 = (1 - a) * (1 - b), w01 = (1 - a) * b, w10 = a * (1 - b), w11 = a * b;
   if (tb.pos[n00] && tb.pos[n00 + 1] && tb.pos[n10] && tb.pos[n10 + 1]) {
     // The shortest wavelength varies most (Rayleigh): it decides.
-    const float lo = std::min(std::min(p00[0], p01[0]), std::min(p10[0], p11[0]));
-    const float hi = std::max(std::max(p00[0], p01[0]), std::max(p10[0], p11[0]));
+    const float* f = tb.first.data();
+    const float lo = std::min(std::min(f[n00], f[n00 + 1]), std::min(f[n10], f[n10 + 1]));
+    const float hi = std::max(std::max(f[n00], f[n00 + 1]), std::max(f[n10], f[n10 + 1]));
     if (hi > 1.02f * lo) {
       const float* l00 = &tb.lt[n00 * nw];
       const float* l01 = &tb.lt[(n00 + 1) * nw];

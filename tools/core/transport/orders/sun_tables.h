@@ -13,12 +13,14 @@
 namespace skybake::orders {
 
 // Radius nodes x theta nodes x nw, and the logarithms (0 where the transmittance is 0) with a
-// per-node flag "every wavelength lit".
+// per-node flag "every wavelength lit" and the grid's shortest wavelength's transmittance (which
+// decides the blend: TransmittanceAt), both of the whole grid in a wavelength batch's slice too.
 struct SunTable {
   std::vector<double> r;
   IntervalLocator loc;
   std::vector<float> t, lt;
   std::vector<uint8_t> pos;
+  std::vector<float> first;
 };
 
 struct SunTables {
@@ -35,5 +37,9 @@ struct SunTables {
 };
 
 SunTables BuildSunTables(const AtmosphereModel& m, const Medium& md, const OrdersSettings& s);
+
+// The tables at the wavelengths ws (indices into sun's, ascending): a wavelength batch of the
+// solve, whose lookups give the same values as the whole tables' at those wavelengths.
+SunTables SliceSunTables(const SunTables& sun, const std::vector<size_t>& ws);
 
 }  // namespace skybake::orders

@@ -56,7 +56,7 @@ void InterpE(const Nodes& nodes, const std::vector<float>& E, double theta_s, fl
     std::fill(out, out + nw, 0.0f);
     return;
   }
-  const Lerp l = Locate(nodes.sun_theta_rad, theta_s);
+  const Lerp l = Locate(nodes.sun_loc, theta_s);
   for (size_t w = 0; w < nw; ++w) {
     out[w] = static_cast<float>(E[l.i * nw + w] * (1.0 - l.t) + E[(l.i + 1) * nw + w] * l.t);
   }

@@ -1,0 +1,92 @@
+// The solve of `orders` in wavelength batches (solve.h): each batch's medium, sun tables and
+// nodes sliced to its wavelengths, solved by SolveOrders, its own wavelengths copied into the
+// whole result.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "transport/orders/kernel.h"
+#include "transport/orders/solve.h"
+
+namespace skybake::orders {
+
+namespace {
+
+// The solve's tables per wavelength (bytes): L, J, L_next (float) and the ratio codes (one byte)
+// per cell, J_ms (float) when kept, and the kernels.
+size_t TableBytesPerWavelength(const Nodes& nodes, const OrdersSettings& s, bool keep_sources) {
+  const size_t cells = nodes.radius.size() * nodes.ns * nodes.nu * static_cast<size_t>(s.nphi);
+  return cells * (3 * sizeof(float) + sizeof(uint8_t) + (keep_sources ? sizeof(float) : 0)) + KernelBytesPerWavelength(nodes, s);
+}
+
+}  // namespace
+
+std::vector<WavelengthBatch> PlanWavelengthBatches(const Medium& md, const Nodes& nodes, const OrdersSettings& s, bool keep_sources) {
+  const size_t nw = md.nw, per_w = TableBytesPerWavelength(nodes, s, keep_sources);
+  const size_t fit = (static_cast<size_t>(s.solve_tables_mib) << 20) / per_w;  // wavelengths whose tables fit
+  if (fit >= nw) return {WavelengthBatch{[&] {
+                           std::vector<size_t> all(nw);
+                           for (size_t w = 0; w < nw; ++w) all[w] = w;
+                           return all;
+                         }(),
+                         0, nw}};
+  // Batches of a multiple of 8 wavelengths solved (the reference among them) where 8 fit: the
+  // solve's products run 8 wavelengths wide with the rest one by one (simd.h), and 13 wavelengths
+  // are one vector and 5 single sums - a batch of cloudy4's 25 at 13 doubled its build's time.
+  const size_t per_batch = std::max<size_t>(2, fit >= 8 ? fit / 8 * 8 : fit);
+  std::vector<WavelengthBatch> batches;
+  for (size_t first = 0; first < nw;) {
+    WavelengthBatch wb;
+    wb.first = first;
+    wb.end = std::min(nw, first + per_batch);
+    if (md.wref < wb.first || md.wref >= wb.end) wb.end = std::min(nw, first + per_batch - 1);  // a place for the reference
+    if (md.wref < wb.first) wb.solve.push_back(md.wref);
+    for (size_t w = wb.first; w < wb.end; ++w) wb.solve.push_back(w);
+    if (md.wref >= wb.end) wb.solve.push_back(md.wref);
+    first = wb.end;
+    batches.push_back(std::move(wb));
+  }
+  return batches;
+}
+
+SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, const SunTables& sun, const Nodes& nodes,
+                                    const OrdersSettings& s, bool keep_sources, const ProgressFn& progress) {
+  const std::vector<WavelengthBatch> batches = PlanWavelengthBatches(md, nodes, s, keep_sources);
+  if (batches.size() == 1) return SolveOrders(m, md, sun, nodes, s, keep_sources, progress);
+  const size_t nw = md.nw;
+  SolveResult out;
+  for (size_t b = 0; b < batches.size(); ++b) {
+    const WavelengthBatch& wb = batches[b];
+    const Medium mb = SliceMedium(md, wb.solve);
+    const SunTables sb = SliceSunTables(sun, wb.solve);
+    Nodes nb = nodes;
+    nb.nw = wb.solve.size();
+    const std::string stage = fmt::format("wavelengths {}-{} of {}: ", wb.first + 1, wb.end, nw);
+    const ProgressFn batch_progress = [&](std::string_view what, double fraction) {
+      ReportProgress(progress, stage + std::string(what), fraction);
+    };
+    const SolveResult r = SolveOrders(m, mb, sb, nb, s, keep_sources, batch_progress);
+    if (b == 0) {
+      out.orders_done = r.orders_done, out.tail = r.tail, out.last_fraction = r.last_fraction;
+      out.ms.assign(r.ms.size() / nb.nw * nw, 0.0f);
+      if (keep_sources) ZeroTable(&out.jms, r.jms.size() / nb.nw * nw);
+    } else if (r.orders_done != out.orders_done || r.tail != out.tail) {
+      throw std::logic_error("orders: wavelength batches stopped at different orders");  // they share the reference's decisions
+    }
+    auto put = [&](const auto& from, auto* to) {
+      const size_t rows = from.size() / nb.nw;
+      for (size_t i = 0; i < rows; ++i) {
+        for (size_t j = 0; j < nb.nw; ++j) {
+          const size_t w = wb.solve[j];
+          if (w >= wb.first && w < wb.end) (*to)[i * nw + w] = from[i * nb.nw + j];
+        }
+      }
+    };
+    put(r.ms, &out.ms);
+    if (keep_sources) put(r.jms, &out.jms);
+  }
+  return out;
+}
+
+}  // namespace skybake::orders
