@@ -20,7 +20,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
-#include "transport/orders/half.h"
+#include <Imath/half.h>
 #include "transport/orders/kernel.h"
 #include "transport/orders/simd.h"
 
@@ -178,8 +178,8 @@ void BuildModalKernel(const KernelContext& kc, ScatterKernels* sk, size_t ri, Co
   ModesFromCoefficients(kc, ri, c, dc, x->g.data(), sk->has_ends ? x->d.data() : nullptr);
   const size_t g0 = ri * sk->modal_floats, d0 = ri * sk->end_floats;
   if (sk->half) {
-    for (size_t i = 0; i < x->g.size(); ++i) sk->modal_half[g0 + i] = HalfFromFloat(x->g[i]);
-    for (size_t i = 0; i < x->d.size(); ++i) sk->end_half[d0 + i] = HalfFromFloat(x->d[i]);
+    for (size_t i = 0; i < x->g.size(); ++i) sk->modal_half[g0 + i] = imath_float_to_half(x->g[i]);
+    for (size_t i = 0; i < x->d.size(); ++i) sk->end_half[d0 + i] = imath_float_to_half(x->d[i]);
   } else {
     std::copy(x->g.begin(), x->g.end(), sk->modal_kernels.begin() + static_cast<std::ptrdiff_t>(g0));
     std::copy(x->d.begin(), x->d.end(), sk->end_kernels.begin() + static_cast<std::ptrdiff_t>(d0));

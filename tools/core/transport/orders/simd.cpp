@@ -6,7 +6,7 @@
 #include <immintrin.h>
 #endif
 
-#include "transport/orders/half.h"
+#include <Imath/half.h>
 
 namespace skybake::orders {
 
@@ -19,19 +19,20 @@ inline V8 LoadV8(const float* p) {
   return x;
 }
 inline void StoreV8(float* p, V8 x) { std::memcpy(p, &x, sizeof x); }
-// 8 binary16 values as floats (exact): vcvtph2ps where the build has F16C, else one by one.
+// 8 binary16 values as floats (exact): vcvtph2ps where the build has F16C, else one by one by
+// Imath's conversion (itself F16C's where the build has it).
 inline V8 LoadV8(const uint16_t* p) {
   V8 x;
 #if defined(__F16C__)
   const __m256 f = _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
   std::memcpy(&x, &f, sizeof x);
 #else
-  for (int i = 0; i < 8; ++i) x[i] = FloatFromHalf(p[i]);
+  for (int i = 0; i < 8; ++i) x[i] = imath_half_to_float(p[i]);
 #endif
   return x;
 }
 inline float ValueOf(float v) { return v; }
-inline float ValueOf(uint16_t v) { return FloatFromHalf(v); }
+inline float ValueOf(uint16_t v) { return imath_half_to_float(v); }
 
 // acc[b * nw + w] (+)= sum_{j ascending < n} g_j x[b * b_stride + j * x_stride + w] for the 4 b of a
 // sun block, g_j = g[j * g_stride + w] (kScalar false: a row per j, loaded once for the 4 b) or

@@ -21,7 +21,7 @@ void ModalBlock4(const float* g, size_t g_stride, const float* x, size_t x_strid
 // The same added to acc.
 void ModalBlock4Add(const float* g, size_t g_stride, const float* x, size_t x_stride, size_t b_stride, size_t n, size_t nw,
                     float* acc);
-// The two with g stored as binary16 (half.h; converted exactly, so each sum rounds as with the
+// The two with g stored as binary16 (Imath's half; converted exactly, so each sum rounds as with the
 // float g of the same values).
 void ModalBlock4(const uint16_t* g, size_t g_stride, const float* x, size_t x_stride, size_t b_stride, size_t n, size_t nw, float* acc);
 void ModalBlock4Add(const uint16_t* g, size_t g_stride, const float* x, size_t x_stride, size_t b_stride, size_t n, size_t nw,
