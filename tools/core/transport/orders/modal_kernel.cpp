@@ -19,8 +19,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
-
 #include <Imath/half.h>
+
 #include "transport/orders/kernel.h"
 #include "transport/orders/simd.h"
 

@@ -56,10 +56,10 @@ struct OrdersSettings {
   // columns); false: the (nd x nd) matrix, the slow and plain form the modal one is tested
   // against ("Scattering kernel" in docs/sky-methods.md).
   bool kernel_modal = true;
-  // The modal kernels stored as IEEE binary16 (Imath's half, round to nearest even) per unit sigma_s*: half the memory and
-  // half the bytes each order's scatter reads; each value within 2^-12 of the float one, the sky
-  // within 0.003 % of the float kernels' at high ("Scattering kernel" in docs/sky-methods.md);
-  // false: floats.
+  // The modal kernels stored as IEEE binary16 (Imath's half, round to nearest even) per unit
+  // sigma_s*: half the memory and half the bytes each order's scatter reads; each value within
+  // 2^-12 of the float one, the sky within 0.003 % of the float kernels' at high ("Scattering
+  // kernel" in docs/sky-methods.md); false: floats.
   bool kernel_half = true;
   // The transport's gather by families (radius/view corners blended once per step for all sun and
   // azimuth nodes); false: cell by cell, 16 corners each (the plain form).
