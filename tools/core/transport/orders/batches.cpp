@@ -25,17 +25,12 @@ size_t TableBytesPerWavelength(const Nodes& nodes, const OrdersSettings& s, bool
 std::vector<WavelengthBatch> PlanWavelengthBatches(const Medium& md, const Nodes& nodes, const OrdersSettings& s, bool keep_sources) {
   const size_t nw = md.nw, per_w = TableBytesPerWavelength(nodes, s, keep_sources);
   const size_t fit = (static_cast<size_t>(s.solve_tables_mib) << 20) / per_w;  // wavelengths whose tables fit
-  if (fit >= nw) return {WavelengthBatch{[&] {
-                           std::vector<size_t> all(nw);
-                           for (size_t w = 0; w < nw; ++w) all[w] = w;
-                           return all;
-                         }(),
-                         0, nw}};
-  // Batches of a multiple of 8 wavelengths solved (the reference among them) where 8 fit: the
-  // solve's products run 8 wavelengths wide (simd.h), and a batch's rows of J are then whole
-  // vectors (16 floats: one cache line per corner of the gather). Measured on cloudy4's LUT (25
+  // One batch of every wavelength where they all fit; else batches of a multiple of 8 wavelengths
+  // solved (the reference among them) where 8 fit: the solve's products run 8 wavelengths wide
+  // (simd.h), and a batch's rows of J are then whole vectors (16 floats: one cache line per
+  // corner of the gather). Measured on cloudy4's LUT (25
   // wavelengths): batches of 16 and 10 257 s, of 13 and 13 346 s, one solve 171 s.
-  const size_t per_batch = std::max<size_t>(2, fit >= 8 ? fit / 8 * 8 : fit);
+  const size_t per_batch = fit >= nw ? nw : std::max<size_t>(2, fit >= 8 ? fit / 8 * 8 : fit);
   std::vector<WavelengthBatch> batches;
   for (size_t first = 0; first < nw;) {
     WavelengthBatch wb;
@@ -57,6 +52,7 @@ SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, 
   if (batches.size() == 1) return SolveOrders(m, md, sun, nodes, s, keep_sources, progress);
   const size_t nw = md.nw;
   SolveResult out;
+  out.wavelength_batches = batches.size();
   for (size_t b = 0; b < batches.size(); ++b) {
     const WavelengthBatch& wb = batches[b];
     const Medium mb = SliceMedium(md, wb.solve);

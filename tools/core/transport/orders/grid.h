@@ -56,6 +56,17 @@ struct UninitAllocator : std::allocator<T> {
 };
 using Table = std::vector<float, UninitAllocator<float>>;
 
+// The columns ws of a table [row * nw + w] (a wavelength batch's slice: medium.h, sun_tables.h).
+template <class V>
+V SliceColumns(const V& v, size_t nw, const std::vector<size_t>& ws) {
+  const size_t rows = v.size() / nw, nv = ws.size();
+  V out(rows * nv);
+  for (size_t i = 0; i < rows; ++i) {
+    for (size_t j = 0; j < nv; ++j) out[i * nv + j] = v[i * nw + ws[j]];
+  }
+  return out;
+}
+
 // v = n zeros: a fresh mapping (zeroed by the kernel) from kMapFrom bytes, else written in
 // parallel blocks.
 void ZeroTable(Table* v, size_t n);

@@ -138,23 +138,8 @@ Medium SliceMedium(const Medium& md, const std::vector<size_t>& ws) {
   b.nw = nv;
   b.wref = static_cast<size_t>(std::find(ws.begin(), ws.end(), md.wref) - ws.begin());
   if (b.wref == nv) throw std::logic_error("orders: a wavelength batch without the reference wavelength");
-  // Every table here is [outer * nw + w]: keep the columns ws of each row.
-  auto slice = [&](const auto& v, auto* out) {
-    const size_t rows = v.size() / nw;
-    out->resize(rows * nv);
-    for (size_t i = 0; i < rows; ++i) {
-      for (size_t j = 0; j < nv; ++j) (*out)[i * nv + j] = v[i * nw + ws[j]];
-    }
-  };
-  slice(md.sigma_t, &b.sigma_t);
-  slice(md.sigma_t_star, &b.sigma_t_star);
-  slice(md.sigma_s, &b.sigma_s);
-  slice(md.sigma_s_star, &b.sigma_s_star);
-  slice(md.sigma_t_view, &b.sigma_t_view);
-  slice(md.f, &b.f);
-  slice(md.phase_star, &b.phase_star);
-  slice(md.albedo, &b.albedo);
-  slice(md.sun_e, &b.sun_e);
+  for (auto* v : {&b.sigma_t, &b.sigma_t_star, &b.sigma_s, &b.sigma_s_star, &b.sigma_t_view, &b.phase_star}) *v = SliceColumns(*v, nw, ws);
+  for (auto* v : {&b.f, &b.albedo, &b.sun_e}) *v = SliceColumns(*v, nw, ws);
   b.phase.clear();  // indexed by the model's wavelengths: the render's, never a batch's
   return b;
 }

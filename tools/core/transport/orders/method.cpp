@@ -26,7 +26,6 @@ class OrdersSolve {
     md_ = orders::PrepareMedium(m_, s_, ss_scaled_ && s_.ss_scaled_view > 0);
     sun_ = orders::BuildSunTables(m_, md_, s_);
     nodes_ = orders::BuildNodes(m_, s_, observer_altitude_m);
-    batches_ = orders::PlanWavelengthBatches(md_, nodes_, s_, segments).size();
     res_ = orders::SolveMultipleScattering(m_, md_, sun_, nodes_, s_, segments, progress);
   }
 
@@ -41,7 +40,7 @@ class OrdersSolve {
         s_.kernel_sub > 0 ? fmt::format("basis-integrated, {} sub-intervals", s_.kernel_sub) : std::string("phase at the nodes"),
         res_.orders_done, res_.tail != orders::Tail::kNone ? "true" : "false", res_.last_fraction, s_.tolerance, ss_scaled_ ? "delta-scaled" : "unscaled",
         res_.tail == orders::Tail::kDominant ? " (dominant mode)" : res_.tail == orders::Tail::kTwoModes ? " (two modes)" : "",
-        batches_);
+        res_.wavelength_batches);
   }
 
   void Render(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,
@@ -68,7 +67,6 @@ class OrdersSolve {
   orders::Medium md_;
   orders::SunTables sun_;
   orders::Nodes nodes_;
-  size_t batches_ = 1;  // the solve's wavelength batches (solve.h)
   orders::SolveResult res_;
   mutable orders::ViewRayCache cache_;
 };

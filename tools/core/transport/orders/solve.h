@@ -32,6 +32,7 @@ struct SolveResult {
   int orders_done = 0;
   Tail tail = Tail::kNone;
   double last_fraction = 0.0;
+  size_t wavelength_batches = 1;  // SolveMultipleScattering's batches
 };
 
 // One solve over every wavelength of md (sun and nodes at md's wavelengths); keep_sources:

@@ -164,19 +164,10 @@ SunTables BuildSunTables(const AtmosphereModel& m, const Medium& md, const Order
 
 SunTables SliceSunTables(const SunTables& sun, const std::vector<size_t>& ws) {
   SunTables b = sun;
-  const size_t nw = sun.nw, nv = ws.size();
-  b.nw = nv;
+  b.nw = ws.size();
   for (SunTable* tb : {&b.plain, &b.star}) {
-    const SunTable& from = tb == &b.plain ? sun.plain : sun.star;
-    const size_t nodes = from.pos.size();
-    tb->t.resize(nodes * nv);
-    tb->lt.resize(nodes * nv);
-    for (size_t n = 0; n < nodes; ++n) {
-      for (size_t j = 0; j < nv; ++j) {
-        tb->t[n * nv + j] = from.t[n * nw + ws[j]];
-        tb->lt[n * nv + j] = from.lt[n * nw + ws[j]];
-      }
-    }
+    tb->t = SliceColumns(tb->t, sun.nw, ws);
+    tb->lt = SliceColumns(tb->lt, sun.nw, ws);
   }
   return b;
 }
