@@ -16,7 +16,9 @@ TransportContext MakeTransportContext(const AtmosphereModel& m, const Medium& md
   tc.m = &m, tc.md = &md, tc.nodes = &nodes, tc.s = &s, tc.fam = &fam;
   tc.nd = nodes.nu * static_cast<size_t>(s.nphi);
   const size_t per_radius = nodes.ns * tc.nd * static_cast<size_t>(s.nt);  // positions per radius node
-  tc.stored_radii = std::min(nodes.radius.size(), (static_cast<size_t>(s.step_positions_mib) << 20) / (per_radius * sizeof(PackedSunAzimuth)));
+  tc.stored_radii = PositionsPackable(nodes.ns, static_cast<size_t>(s.nphi))
+                        ? std::min(nodes.radius.size(), (static_cast<size_t>(s.step_positions_mib) << 20) / (per_radius * sizeof(PackedSunAzimuth)))
+                        : 0;
   tc.sun_az.resize(tc.stored_radii * per_radius);
   for (double ts : nodes.sun_theta_rad) tc.cos_sun.push_back(std::cos(ts));
   tc.loglin_first = nodes.ns;
@@ -31,7 +33,7 @@ TransportContext MakeTransportContext(const AtmosphereModel& m, const Medium& md
 
 SunAzimuth TransportContext::StepPosition(const Family& f, size_t step, size_t ri, size_t si, size_t k, size_t q, double nu_s) const {
   if (Stored(ri)) return UnpackSunAzimuth(sun_az[nodes->Cell(ri, si, k, q) * static_cast<size_t>(s->nt) + step]);
-  return UnpackSunAzimuth(PackSunAzimuth(StepSunAzimuth(*nodes, s->azimuth_even, f, step, nodes->radius[ri], cos_sun[si], nu_s)));
+  return QuantizeSunAzimuth(StepSunAzimuth(*nodes, s->azimuth_even, f, step, nodes->radius[ri], cos_sun[si], nu_s));
 }
 
 void GroundIrradiance(const Nodes& nodes, int ndn, const Table& L, std::vector<float>* E) {

@@ -21,19 +21,33 @@ namespace skybake::orders {
 // wavelength, for the intervals from loglin_from_deg on.
 constexpr size_t kLogBins = 16;
 
-// A step's SunAzimuth as TransportContext stores it: the weights ts and tq in 16-bit fixed point
-// (k / 65535, within 7.6e-6 of the float weight; 0 and 1 exact), 8 bytes instead of 12 (high's
-// daylight table: 155 MB instead of 233 MB). Every lookup reads the packed form, stored or
-// computed, so the two give the same bytes.
-struct PackedSunAzimuth {
-  uint16_t si = 0, q0 = 0, ts = 0, tq = 0;
-};
-inline PackedSunAzimuth PackSunAzimuth(const SunAzimuth& p) {
-  auto fixed = [](float t) { return static_cast<uint16_t>(std::lround(std::clamp(t, 0.0f, 1.0f) * 65535.0f)); };
-  return {p.si, p.q0, fixed(p.ts), fixed(p.tq)};
+// A step's SunAzimuth as TransportContext stores it, in 32 bits: the sun node si (bits 0-5, 63 for
+// kNoSun), the azimuth node q0 (bits 6-11) and the weights ts (bits 12-21) and tq (bits 22-31) in
+// 10-bit fixed point, k / 1023 (within 4.9e-4 of the float weight; 0 and 1 exact). 4 bytes per
+// (cell, step) instead of 12 (high's daylight tables: 4.6 MB per radius node), so that the
+// budget holds the positions of 58 of the thick skies' 65 radius nodes. Every lookup reads the
+// quantized weights, stored or computed (QuantizeSunAzimuth), so the two give the same bytes. The
+// indices fit where a solve has at most 64 sun nodes and 64 azimuths (PositionsPackable); beyond
+// (expert overrides only) every position is computed.
+using PackedSunAzimuth = uint32_t;
+constexpr uint32_t kWeightSteps = 1023;  // 10 bits
+constexpr uint32_t kPackedNoSun = 63;    // 6 bits
+inline uint32_t WeightCode(float t) { return static_cast<uint32_t>(std::lround(std::clamp(t, 0.0f, 1.0f) * static_cast<float>(kWeightSteps))); }
+inline float WeightOfCode(uint32_t k) { return static_cast<float>(k) / static_cast<float>(kWeightSteps); }
+inline SunAzimuth QuantizeSunAzimuth(SunAzimuth p) {
+  p.ts = WeightOfCode(WeightCode(p.ts));
+  p.tq = WeightOfCode(WeightCode(p.tq));
+  return p;
 }
-inline SunAzimuth UnpackSunAzimuth(const PackedSunAzimuth& p) {
-  return {p.si, p.q0, static_cast<float>(p.ts) / 65535.0f, static_cast<float>(p.tq) / 65535.0f};
+inline bool PositionsPackable(size_t ns, size_t nphi) { return ns <= 64 && nphi <= 64; }
+inline PackedSunAzimuth PackSunAzimuth(const SunAzimuth& p) {
+  const uint32_t si = p.si == kNoSun ? kPackedNoSun : p.si;
+  return si | static_cast<uint32_t>(p.q0) << 6 | WeightCode(p.ts) << 12 | WeightCode(p.tq) << 22;
+}
+inline SunAzimuth UnpackSunAzimuth(PackedSunAzimuth v) {
+  const uint32_t si = v & 63u;
+  return {static_cast<uint16_t>(si == kPackedNoSun ? kNoSun : si), static_cast<uint16_t>(v >> 6 & 63u), WeightOfCode(v >> 12 & 1023u),
+          WeightOfCode(v >> 22)};
 }
 
 struct TransportContext {
@@ -45,7 +59,8 @@ struct TransportContext {
   // The sun/azimuth interpolation position of every (cell, step) of the first stored_radii radius
   // nodes, [Cell * nt + step], shared by all orders (saves two acos and a node search per lookup
   // and order; order 1 fills it); the other radius nodes' positions are computed per lookup. As
-  // many radius nodes as fit in OrdersSettings::step_positions_mib.
+  // many radius nodes as fit in OrdersSettings::step_positions_mib (none where the indices do not
+  // fit the packed form: PositionsPackable).
   std::vector<PackedSunAzimuth> sun_az;
   size_t stored_radii = 0;
   std::vector<double> cos_sun;  // cos of each sun node's zenith angle
