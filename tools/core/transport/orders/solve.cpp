@@ -22,7 +22,7 @@ namespace {
 void FirstOrder(const AtmosphereModel& m, const Medium& md, const SunTables& sun, TransportContext* tc, Table* L) {
   const Nodes& nodes = *tc->nodes;
   const size_t nw = md.nw, nc = md.nc, ns = nodes.ns, nu = nodes.nu, nr = nodes.radius.size();
-  const size_t nphi = static_cast<size_t>(nodes.nphi), nt = static_cast<size_t>(tc->s->nt);
+  const size_t nphi = static_cast<size_t>(nodes.nphi);
   const double R = m.bottom_radius_m;
   std::vector<float> E0(ns * nw);  // direct sun at the ground (scaled transmittance)
   {
@@ -62,7 +62,7 @@ void FirstOrder(const AtmosphereModel& m, const Medium& md, const SunTables& sun
           }
           for (size_t w = 0; w < nw; ++w) acc[w] += f.wt[st * nw + w] * src[w] * tsun[w] * static_cast<float>(md.sun_e[w]);
           if (tc->Stored(ri)) {
-            tc->sun_az[nodes.Cell(ri, si, k, q) * nt + st] =
+            tc->sun_az[tc->PositionIndex(ri, k, st, si, q)] =
                 PackSunAzimuth(StepSunAzimuth(nodes, tc->s->azimuth_even, f, st, r, tc->cos_sun[si], nu_s));
           }
         }

@@ -15,7 +15,8 @@ TransportContext MakeTransportContext(const AtmosphereModel& m, const Medium& md
   TransportContext tc;
   tc.m = &m, tc.md = &md, tc.nodes = &nodes, tc.s = &s, tc.fam = &fam;
   tc.nd = nodes.nu * static_cast<size_t>(s.nphi);
-  const size_t per_radius = nodes.ns * tc.nd * static_cast<size_t>(s.nt);  // positions per radius node
+  tc.nt = static_cast<size_t>(s.nt), tc.plane = nodes.ns * static_cast<size_t>(s.nphi);
+  const size_t per_radius = nodes.ns * tc.nd * tc.nt;  // positions per radius node
   tc.stored_radii = PositionsPackable(nodes.ns, static_cast<size_t>(s.nphi))
                         ? std::min(nodes.radius.size(), (static_cast<size_t>(s.step_positions_mib) << 20) / (per_radius * sizeof(PackedSunAzimuth)))
                         : 0;
@@ -31,8 +32,7 @@ TransportContext MakeTransportContext(const AtmosphereModel& m, const Medium& md
   return tc;
 }
 
-SunAzimuth TransportContext::StepPosition(const Family& f, size_t step, size_t ri, size_t si, size_t k, size_t q, double nu_s) const {
-  if (Stored(ri)) return UnpackSunAzimuth(sun_az[nodes->Cell(ri, si, k, q) * static_cast<size_t>(s->nt) + step]);
+SunAzimuth TransportContext::ComputedStepPosition(const Family& f, size_t step, size_t ri, size_t si, double nu_s) const {
   return QuantizeSunAzimuth(StepSunAzimuth(*nodes, s->azimuth_even, f, step, nodes->radius[ri], cos_sun[si], nu_s));
 }
 

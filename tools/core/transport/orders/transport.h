@@ -3,6 +3,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -33,7 +34,14 @@ using PackedSunAzimuth = uint32_t;
 constexpr uint32_t kWeightSteps = 1023;  // 10 bits
 constexpr uint32_t kPackedNoSun = 63;    // 6 bits
 inline uint32_t WeightCode(float t) { return static_cast<uint32_t>(std::lround(std::clamp(t, 0.0f, 1.0f) * static_cast<float>(kWeightSteps))); }
-inline float WeightOfCode(uint32_t k) { return static_cast<float>(k) / static_cast<float>(kWeightSteps); }
+// k / 1023 for every code, as a table: the same floats as the division (correctly rounded either
+// way), without the division's latency in every lookup.
+inline constexpr std::array<float, kWeightSteps + 1> kWeightOfCode = [] {
+  std::array<float, kWeightSteps + 1> w{};
+  for (uint32_t k = 0; k <= kWeightSteps; ++k) w[k] = static_cast<float>(k) / static_cast<float>(kWeightSteps);
+  return w;
+}();
+inline float WeightOfCode(uint32_t k) { return kWeightOfCode[k]; }
 inline SunAzimuth QuantizeSunAzimuth(SunAzimuth p) {
   p.ts = WeightOfCode(WeightCode(p.ts));
   p.tq = WeightOfCode(WeightCode(p.tq));
@@ -57,7 +65,7 @@ struct TransportContext {
   const OrdersSettings* s = nullptr;
   const std::vector<Family>* fam = nullptr;
   // The sun/azimuth interpolation position of every (cell, step) of the first stored_radii radius
-  // nodes, [Cell * nt + step], shared by all orders (saves two acos and a node search per lookup
+  // nodes, family by family and step by step, [PositionIndex], shared by all orders (saves two acos and a node search per lookup
   // and order; order 1 fills it); the other radius nodes' positions are computed per lookup. As
   // many radius nodes as fit in OrdersSettings::step_positions_mib (none where the indices do not
   // fit the packed form: PositionsPackable).
@@ -67,10 +75,22 @@ struct TransportContext {
   size_t loglin_first = 0;      // the first sun interval blended log-linearly (ns: none)
   size_t nd = 0;                // directions per (radius, sun)
 
+  size_t nt = 0;                // steps per table ray
+  size_t plane = 0;             // cells per family: ns x nphi
+
   bool Stored(size_t ri) const { return ri < stored_radii; }
+  // Where cell (ri, si, k, q)'s position at step `step` is in sun_az: a family's cells at one step
+  // are contiguous, in the order the transport visits them.
+  size_t PositionIndex(size_t ri, size_t k, size_t step, size_t si, size_t q) const {
+    return ((ri * nodes->nu + k) * nt + step) * plane + si * static_cast<size_t>(nodes->nphi) + q;
+  }
   // Cell (ri, si, k, q)'s position at step `step` of family f; nu_s: the cell's scattering
   // cosine (Nodes::CellGeometry).
-  SunAzimuth StepPosition(const Family& f, size_t step, size_t ri, size_t si, size_t k, size_t q, double nu_s) const;
+  SunAzimuth StepPosition(const Family& f, size_t step, size_t ri, size_t si, size_t k, size_t q, double nu_s) const {
+    if (Stored(ri)) return UnpackSunAzimuth(sun_az[PositionIndex(ri, k, step, si, q)]);
+    return ComputedStepPosition(f, step, ri, si, nu_s);
+  }
+  SunAzimuth ComputedStepPosition(const Family& f, size_t step, size_t ri, size_t si, double nu_s) const;
 };
 
 TransportContext MakeTransportContext(const AtmosphereModel& m, const Medium& md, const Nodes& nodes, const OrdersSettings& s,

@@ -41,16 +41,21 @@ void FamilyGeometry(const TransportContext& tc, size_t ri, size_t k, FamilyScrat
 // The cells' sun/azimuth positions at step m into x->pts, and the sun nodes [*s_lo, *s_hi] they read.
 void StepPositions(const TransportContext& tc, const Family& f, size_t m, size_t ri, size_t k, FamilyScratch* x, size_t* s_lo,
                    size_t* s_hi) {
-  const size_t ns = tc.nodes->ns, nphi = static_cast<size_t>(tc.nodes->nphi);
-  *s_lo = ns, *s_hi = 0;
-  for (size_t si = 0; si < ns; ++si) {
-    for (size_t q = 0; q < nphi; ++q) {
-      const SunAzimuth p = tc.StepPosition(f, m, ri, si, k, q, x->nu[si * nphi + q]);
-      x->pts[si * nphi + q] = p;
-      if (p.si == kNoSun) continue;
-      *s_lo = std::min<size_t>(*s_lo, p.si);
-      *s_hi = std::max<size_t>(*s_hi, std::min<size_t>(p.si + 1, ns - 1));
+  const size_t ns = tc.nodes->ns, nphi = static_cast<size_t>(tc.nodes->nphi), plane = tc.plane;
+  if (tc.Stored(ri)) {
+    const PackedSunAzimuth* from = &tc.sun_az[tc.PositionIndex(ri, k, m, 0, 0)];  // the family's cells at step m, in order
+    for (size_t cell = 0; cell < plane; ++cell) x->pts[cell] = UnpackSunAzimuth(from[cell]);
+  } else {
+    for (size_t si = 0; si < ns; ++si) {
+      for (size_t q = 0; q < nphi; ++q) x->pts[si * nphi + q] = tc.ComputedStepPosition(f, m, ri, si, x->nu[si * nphi + q]);
     }
+  }
+  *s_lo = ns, *s_hi = 0;
+  for (size_t cell = 0; cell < plane; ++cell) {
+    const SunAzimuth& p = x->pts[cell];
+    if (p.si == kNoSun) continue;
+    *s_lo = std::min<size_t>(*s_lo, p.si);
+    *s_hi = std::max<size_t>(*s_hi, std::min<size_t>(p.si + 1, ns - 1));
   }
 }
 
