@@ -26,7 +26,7 @@ constexpr size_t kLogBins = 16;
 // kNoSun), the azimuth node q0 (bits 6-11) and the weights ts (bits 12-21) and tq (bits 22-31) in
 // 10-bit fixed point, k / 1023 (within 4.9e-4 of the float weight; 0 and 1 exact). 4 bytes per
 // (cell, step) instead of 12 (high's daylight tables: 4.6 MB per radius node), so that the
-// budget holds the positions of 58 of the thick skies' 65 radius nodes. Every lookup reads the
+// default budget (256 MiB) holds the positions of 58 of the thick skies' 65 radius nodes. Every lookup reads the
 // quantized weights, stored or computed (QuantizeSunAzimuth), so the two give the same bytes. The
 // indices fit where a solve has at most 64 sun nodes and 64 azimuths (PositionsPackable); beyond
 // (expert overrides only) every position is computed.
@@ -65,16 +65,16 @@ struct TransportContext {
   const OrdersSettings* s = nullptr;
   const std::vector<Family>* fam = nullptr;
   // The sun/azimuth interpolation position of every (cell, step) of the first stored_radii radius
-  // nodes, family by family and step by step, [PositionIndex], shared by all orders (saves two acos and a node search per lookup
-  // and order; order 1 fills it); the other radius nodes' positions are computed per lookup. As
-  // many radius nodes as fit in OrdersSettings::step_positions_mib (none where the indices do not
-  // fit the packed form: PositionsPackable).
+  // nodes, family by family and step by step ([PositionIndex]), shared by all orders (saves two
+  // acos and a node search per lookup and order; order 1 fills it); the other radius nodes'
+  // positions are computed per lookup. As many radius nodes as fit in
+  // OrdersSettings::step_positions_mib (none where the indices do not fit the packed form:
+  // PositionsPackable).
   std::vector<PackedSunAzimuth> sun_az;
   size_t stored_radii = 0;
   std::vector<double> cos_sun;  // cos of each sun node's zenith angle
   size_t loglin_first = 0;      // the first sun interval blended log-linearly (ns: none)
   size_t nd = 0;                // directions per (radius, sun)
-
   size_t nt = 0;                // steps per table ray
   size_t plane = 0;             // cells per family: ns x nphi
 
