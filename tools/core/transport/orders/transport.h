@@ -53,9 +53,9 @@ inline PackedSunAzimuth PackSunAzimuth(const SunAzimuth& p) {
   return si | static_cast<uint32_t>(p.q0) << 6 | WeightCode(p.ts) << 12 | WeightCode(p.tq) << 22;
 }
 inline SunAzimuth UnpackSunAzimuth(PackedSunAzimuth v) {
-  const uint32_t si = v & 63u;
-  return {static_cast<uint16_t>(si == kPackedNoSun ? kNoSun : si), static_cast<uint16_t>(v >> 6 & 63u), WeightOfCode(v >> 12 & 1023u),
-          WeightOfCode(v >> 22)};
+  const uint32_t si = v & kPackedNoSun;  // the 6-bit fields' mask
+  return {static_cast<uint16_t>(si == kPackedNoSun ? kNoSun : si), static_cast<uint16_t>(v >> 6 & kPackedNoSun),
+          WeightOfCode(v >> 12 & kWeightSteps), WeightOfCode(v >> 22)};
 }
 
 struct TransportContext {
