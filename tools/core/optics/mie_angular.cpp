@@ -208,8 +208,7 @@ __attribute__((target("avx512f"))) void DirectSumsAvx512(const double* coef, siz
     const double* tile = tables + k * tile_stride;
     for (size_t j = 0; j < n; ++j) {
       const double* t = tile + j * R;
-      const V8 ar = Splat8(coef[4 * j]), ai = Splat8(coef[4 * j + 1]);
-      const V8 br = Splat8(coef[4 * j + 2]), bi = Splat8(coef[4 * j + 3]);
+      const double ar = coef[4 * j], ai = coef[4 * j + 1], br = coef[4 * j + 2], bi = coef[4 * j + 3];
       const V8 p = Load8(t), qt = Load8(t + T), q = Load8(t + 2 * T), pt = Load8(t + 3 * T);
       u0 += ar * p;
       u1 += ai * p;
@@ -282,83 +281,99 @@ void GramUpdate(double* ga, double* gb, size_t stride, size_t terms, const doubl
 // out[j] = (p^T G_A p + q^T G_B q)/4 at +mu_j and (q~^T G_A q~ + p~^T G_B p~)/4 at -mu_j, using
 // x^T G x = sum_n x_n (G_nn x_n + 2 sum_{n' < n} G_nn' x_n'). Per row n the inner sum runs in two
 // partial sums (n' even, n' odd; an odd row's last column n - 1 goes to the even one), and the
-// rows are visited in pairs (n, n + 1), n even, which share the loads of the tables' columns:
-// the table loads, not the arithmetic, bound this kernel. NT tiles of angles share each pass over
-// G (one broadcast of G_nn' serves NT tiles). Every lane's operations are those of the plain
-// row-by-row loop with those two partial sums, in the 8-lane and the 4-lane forms alike.
+// rows are visited in pairs (n, n + 1), n even, which share the loads of the tables' columns.
+// NT tiles of angles share each pass over G (one broadcast of G_nn' serves NT tiles). Every
+// lane's operations are those of the plain row-by-row loop with those two partial sums, in the
+// 8-lane and the 4-lane forms alike.
+//
+// One matrix's part of NT tiles, from the tables' columns at `part` ((p, q~) with G_A, (q, p~)
+// with G_B): acc_x at +mu, acc_y at -mu. Not inlined, so that the other matrix's sums wait in
+// memory: two tiles' 16 partial sums, 4 accumulators, 4 table columns and 4 broadcasts of G fit
+// the 32 registers (a partial sum spilled to the stack makes every pass over a column pair wait
+// on its store and reload: 1.5x the evaluation's time). G's elements multiply the columns as
+// scalars, which GCC broadcasts straight from memory (a Splat8 of a loaded value goes through
+// the stack).
+template <size_t NT>
+__attribute__((target("avx512f"), noinline)) void EvaluatePart(const double* g, size_t stride, size_t terms,
+                                                                const double* tiles0, size_t tile_stride, size_t part,
+                                                                V8* acc_x, V8* acc_y) {
+  constexpr size_t T = AngularTables::kTile;
+  constexpr size_t R = AngularTables::kRow;
+  for (size_t t = 0; t < NT; ++t) acc_x[t] = acc_y[t] = Splat8(0.0);
+  size_t row = 0;
+  for (; row + 2 <= terms; row += 2) {
+    const double* g0 = g + row * stride;  // rows n = row (even) and n + 1
+    const double* g1 = g0 + stride;
+    V8 ax0[NT], ax1[NT], ay0[NT], ay1[NT], bx0[NT], bx1[NT], by0[NT], by1[NT];
+    for (size_t t = 0; t < NT; ++t) {
+      ax0[t] = ax1[t] = ay0[t] = ay1[t] = bx0[t] = bx1[t] = by0[t] = by1[t] = Splat8(0.0);
+    }
+    for (size_t c = 0; c < row; c += 2) {
+      const double a0 = g0[c], a1 = g0[c + 1], b0 = g1[c], b1 = g1[c + 1];
+      for (size_t t = 0; t < NT; ++t) {
+        const double* tt = tiles0 + t * tile_stride + part + c * R;
+        const V8 x0 = Load8(tt), y0 = Load8(tt + T), x1 = Load8(tt + R), y1 = Load8(tt + R + T);
+        ax0[t] += a0 * x0;
+        ay0[t] += a0 * y0;
+        ax1[t] += a1 * x1;
+        ay1[t] += a1 * y1;
+        bx0[t] += b0 * x0;
+        by0[t] += b0 * y0;
+        bx1[t] += b1 * x1;
+        by1[t] += b1 * y1;
+      }
+    }
+    const double bl = g1[row], d0 = g0[row], d1 = g1[row + 1];
+    for (size_t t = 0; t < NT; ++t) {
+      const double* tt = tiles0 + t * tile_stride + part + row * R;
+      const V8 x0 = Load8(tt), y0 = Load8(tt + T), x1 = Load8(tt + R), y1 = Load8(tt + R + T);
+      bx0[t] += bl * x0;  // row n + 1's last column, n
+      by0[t] += bl * y0;
+      acc_x[t] += x0 * (d0 * x0 + 2.0 * (ax0[t] + ax1[t]));
+      acc_y[t] += y0 * (d0 * y0 + 2.0 * (ay0[t] + ay1[t]));
+      acc_x[t] += x1 * (d1 * x1 + 2.0 * (bx0[t] + bx1[t]));
+      acc_y[t] += y1 * (d1 * y1 + 2.0 * (by0[t] + by1[t]));
+    }
+  }
+  if (row < terms) {  // the last row alone (even: its columns pair up)
+    const double* g0 = g + row * stride;
+    V8 ax0[NT], ax1[NT], ay0[NT], ay1[NT];
+    for (size_t t = 0; t < NT; ++t) ax0[t] = ax1[t] = ay0[t] = ay1[t] = Splat8(0.0);
+    for (size_t c = 0; c < row; c += 2) {
+      const double a0 = g0[c], a1 = g0[c + 1];
+      for (size_t t = 0; t < NT; ++t) {
+        const double* tt = tiles0 + t * tile_stride + part + c * R;
+        ax0[t] += a0 * Load8(tt);
+        ay0[t] += a0 * Load8(tt + T);
+        ax1[t] += a1 * Load8(tt + R);
+        ay1[t] += a1 * Load8(tt + R + T);
+      }
+    }
+    const double d0 = g0[row];
+    for (size_t t = 0; t < NT; ++t) {
+      const double* tt = tiles0 + t * tile_stride + part + row * R;
+      const V8 x0 = Load8(tt), y0 = Load8(tt + T);
+      acc_x[t] += x0 * (d0 * x0 + 2.0 * (ax0[t] + ax1[t]));
+      acc_y[t] += y0 * (d0 * y0 + 2.0 * (ay0[t] + ay1[t]));
+    }
+  }
+}
+
+// Both matrices' parts of NT tiles: plus at +mu, minus at -mu (0 + G_A's part + G_B's).
 template <size_t NT>
 __attribute__((always_inline)) inline void EvaluateTiles(const double* ga, const double* gb, size_t stride,
                                                          size_t terms, const double* tiles0, size_t tile_stride,
                                                          V8* plus, V8* minus) {
   constexpr size_t T = AngularTables::kTile;
-  constexpr size_t R = AngularTables::kRow;
-  for (size_t t = 0; t < NT; ++t) plus[t] = minus[t] = Splat8(0.0);
-  for (int which = 0; which < 2; ++which) {
-    const double* g = which == 0 ? ga : gb;
-    const size_t part = which == 0 ? 0 : 2 * T;  // (p, q~) with G_A; (q, p~) with G_B
-    V8 acc_x[NT], acc_y[NT];
-    for (size_t t = 0; t < NT; ++t) acc_x[t] = acc_y[t] = Splat8(0.0);
-    size_t row = 0;
-    for (; row + 2 <= terms; row += 2) {
-      const double* g0 = g + row * stride;  // rows n = row (even) and n + 1
-      const double* g1 = g0 + stride;
-      V8 ax0[NT], ax1[NT], ay0[NT], ay1[NT], bx0[NT], bx1[NT], by0[NT], by1[NT];
-      for (size_t t = 0; t < NT; ++t) {
-        ax0[t] = ax1[t] = ay0[t] = ay1[t] = bx0[t] = bx1[t] = by0[t] = by1[t] = Splat8(0.0);
-      }
-      for (size_t c = 0; c < row; c += 2) {
-        const V8 a0 = Splat8(g0[c]), a1 = Splat8(g0[c + 1]), b0 = Splat8(g1[c]), b1 = Splat8(g1[c + 1]);
-        for (size_t t = 0; t < NT; ++t) {
-          const double* tt = tiles0 + t * tile_stride + part + c * R;
-          const V8 x0 = Load8(tt), y0 = Load8(tt + T), x1 = Load8(tt + R), y1 = Load8(tt + R + T);
-          ax0[t] += a0 * x0;
-          ay0[t] += a0 * y0;
-          ax1[t] += a1 * x1;
-          ay1[t] += a1 * y1;
-          bx0[t] += b0 * x0;
-          by0[t] += b0 * y0;
-          bx1[t] += b1 * x1;
-          by1[t] += b1 * y1;
-        }
-      }
-      const V8 bl = Splat8(g1[row]), d0 = Splat8(g0[row]), d1 = Splat8(g1[row + 1]);
-      for (size_t t = 0; t < NT; ++t) {
-        const double* tt = tiles0 + t * tile_stride + part + row * R;
-        const V8 x0 = Load8(tt), y0 = Load8(tt + T), x1 = Load8(tt + R), y1 = Load8(tt + R + T);
-        bx0[t] += bl * x0;  // row n + 1's last column, n
-        by0[t] += bl * y0;
-        acc_x[t] += x0 * (d0 * x0 + 2.0 * (ax0[t] + ax1[t]));
-        acc_y[t] += y0 * (d0 * y0 + 2.0 * (ay0[t] + ay1[t]));
-        acc_x[t] += x1 * (d1 * x1 + 2.0 * (bx0[t] + bx1[t]));
-        acc_y[t] += y1 * (d1 * y1 + 2.0 * (by0[t] + by1[t]));
-      }
-    }
-    if (row < terms) {  // the last row alone (even: its columns pair up)
-      const double* g0 = g + row * stride;
-      V8 ax0[NT], ax1[NT], ay0[NT], ay1[NT];
-      for (size_t t = 0; t < NT; ++t) ax0[t] = ax1[t] = ay0[t] = ay1[t] = Splat8(0.0);
-      for (size_t c = 0; c < row; c += 2) {
-        const V8 a0 = Splat8(g0[c]), a1 = Splat8(g0[c + 1]);
-        for (size_t t = 0; t < NT; ++t) {
-          const double* tt = tiles0 + t * tile_stride + part + c * R;
-          ax0[t] += a0 * Load8(tt);
-          ay0[t] += a0 * Load8(tt + T);
-          ax1[t] += a1 * Load8(tt + R);
-          ay1[t] += a1 * Load8(tt + R + T);
-        }
-      }
-      const V8 d0 = Splat8(g0[row]);
-      for (size_t t = 0; t < NT; ++t) {
-        const double* tt = tiles0 + t * tile_stride + part + row * R;
-        const V8 x0 = Load8(tt), y0 = Load8(tt + T);
-        acc_x[t] += x0 * (d0 * x0 + 2.0 * (ax0[t] + ax1[t]));
-        acc_y[t] += y0 * (d0 * y0 + 2.0 * (ay0[t] + ay1[t]));
-      }
-    }
-    for (size_t t = 0; t < NT; ++t) {
-      plus[t] += acc_x[t];
-      minus[t] += acc_y[t];
-    }
+  V8 ax[NT], ay[NT], bx[NT], by[NT];
+  EvaluatePart<NT>(ga, stride, terms, tiles0, tile_stride, 0, ax, ay);
+  EvaluatePart<NT>(gb, stride, terms, tiles0, tile_stride, 2 * T, bx, by);
+  for (size_t t = 0; t < NT; ++t) {
+    plus[t] = minus[t] = Splat8(0.0);
+    plus[t] += ax[t];
+    minus[t] += ay[t];
+    plus[t] += bx[t];
+    minus[t] += by[t];
   }
 }
 
