@@ -93,6 +93,65 @@ void Gather16(const float* const* v, const float* wv, int k0, int k1, size_t nw,
   }
 }
 
+namespace {
+
+// sum_{b < 4} ws[b] v[b][w .. w + 7], from 0 in b order (Gather16's sum).
+inline V8 Corners4V8(const float* const* v, const float* ws, size_t w) {
+  V8 sum = {};
+  for (int b = 0; b < 4; ++b) sum += ws[b] * LoadV8(v[b] + w);
+  return sum;
+}
+inline float Corners4(const float* const* v, const float* ws, size_t w) {
+  float sum = 0.0f;
+  for (int b = 0; b < 4; ++b) sum += ws[b] * v[b][w];
+  return sum;
+}
+
+}  // namespace
+
+void GatherLoHi(const float* const* v, const float* wv, size_t n, float* lo, float* hi, float* sum) {
+  size_t e = 0;
+  for (; e + 8 <= n; e += 8) {
+    V8 l = {}, h = {};
+    l += wv[0] * LoadV8(v[0] + e);
+    l += wv[1] * LoadV8(v[1] + e);
+    h += wv[2] * LoadV8(v[2] + e);
+    h += wv[3] * LoadV8(v[3] + e);
+    StoreV8(lo + e, l);
+    StoreV8(hi + e, h);
+    StoreV8(sum + e, l + h);
+  }
+  for (; e < n; ++e) {
+    float l = 0.0f, h = 0.0f;
+    l += wv[0] * v[0][e];
+    l += wv[1] * v[1][e];
+    h += wv[2] * v[2][e];
+    h += wv[3] * v[3][e];
+    lo[e] = l, hi[e] = h, sum[e] = l + h;
+  }
+}
+
+void AccumulateCorners4(const float* const* v, const float* ws, const float* gm, size_t nw, float* acc) {
+  size_t w = 0;
+  for (; w + 8 <= nw; w += 8) StoreV8(acc + w, LoadV8(acc + w) + LoadV8(gm + w) * Corners4V8(v, ws, w));
+  for (; w < nw; ++w) acc[w] += gm[w] * Corners4(v, ws, w);
+}
+
+void AccumulateCorners4LogLin(const float* const* vl, const float* const* vh, const float* ws, const float* c0, const float* c1,
+                              float tb, const float* gm, size_t nw, float* acc) {
+  size_t w = 0;
+  for (; w + 8 <= nw; w += 8) {
+    const V8 c0w = LoadV8(c0 + w), c1w = LoadV8(c1 + w);
+    const V8 f0 = c0w + (LoadV8(c0 + nw + w) - c0w) * tb, f1 = c1w + (LoadV8(c1 + nw + w) - c1w) * tb;
+    const V8 j = Corners4V8(vl, ws, w) * f0 + Corners4V8(vh, ws, w) * f1;
+    StoreV8(acc + w, LoadV8(acc + w) + LoadV8(gm + w) * j);
+  }
+  for (; w < nw; ++w) {
+    const float f0 = c0[w] + (c0[w + nw] - c0[w]) * tb, f1 = c1[w] + (c1[w + nw] - c1[w]) * tb;
+    acc[w] += gm[w] * (Corners4(vl, ws, w) * f0 + Corners4(vh, ws, w) * f1);
+  }
+}
+
 void ModalAnalysis(const float* l, const float* cos_mq, size_t nm, size_t nq, size_t nw, float* out, size_t out_stride) {
   size_t m = 0;
   for (; m + 4 <= nm; m += 4) {

@@ -99,14 +99,22 @@ void AddGroundReflection(const Nodes& nodes, const Medium& md, const Family& f, 
   for (size_t w = 0; w < md.nw; ++w) acc[w] += f.trans_end[w] * static_cast<float>(md.albedo[w] / kPi) * eg[w];
 }
 
-void LogBlend(const TransportContext& tc, const std::vector<float>& cfac, const SunAzimuth& p, size_t r0, float* jlo, const float* jhi) {
+void LogLinBins(const TransportContext& tc, const std::vector<float>& cfac, const SunAzimuth& p, size_t r0, const float** c0,
+                const float** c1, float* tb) {
   const size_t nw = tc.md->nw, ns = tc.nodes->ns, nr = tc.nodes->radius.size();
   const float fb = p.ts * kLogBins;
   const size_t b0 = std::min(static_cast<size_t>(fb), kLogBins - 1);
-  const float tb = fb - static_cast<float>(b0);
+  *tb = fb - static_cast<float>(b0);
   const size_t r1 = std::min(r0 + 1, nr - 1);
-  const float* c00 = &cfac[((r0 * ns + p.si) * (kLogBins + 1) + b0) * nw];
-  const float* c10 = &cfac[((r1 * ns + p.si) * (kLogBins + 1) + b0) * nw];
+  *c0 = &cfac[((r0 * ns + p.si) * (kLogBins + 1) + b0) * nw];
+  *c1 = &cfac[((r1 * ns + p.si) * (kLogBins + 1) + b0) * nw];
+}
+
+void LogBlend(const TransportContext& tc, const std::vector<float>& cfac, const SunAzimuth& p, size_t r0, float* jlo, const float* jhi) {
+  const size_t nw = tc.md->nw;
+  const float *c00, *c10;
+  float tb;
+  LogLinBins(tc, cfac, p, r0, &c00, &c10, &tb);
   for (size_t w = 0; w < nw; ++w) {
     const float f0 = c00[w] + (c00[w + nw] - c00[w]) * tb, f1 = c10[w] + (c10[w + nw] - c10[w]) * tb;
     jlo[w] = jlo[w] * f0 + jhi[w] * f1;

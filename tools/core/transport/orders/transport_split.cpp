@@ -22,11 +22,11 @@ namespace {
 // factor), for s >= loglin_first; acc: the family's cells; pts: their positions at a step; nu:
 // their scattering cosines.
 struct FamilyScratch {
-  std::vector<float> slab, lo, hi, acc, jv, jv2, eg;
+  std::vector<float> slab, lo, hi, acc, eg;
   std::vector<SunAzimuth> pts;
   std::vector<double> nu;
   FamilyScratch(size_t plane, size_t nw)
-      : slab(plane * nw), lo(plane * nw), hi(plane * nw), acc(plane * nw), jv(nw), jv2(nw), eg(nw), pts(plane), nu(plane) {}
+      : slab(plane * nw), lo(plane * nw), hi(plane * nw), acc(plane * nw), eg(nw), pts(plane), nu(plane) {}
 };
 
 // The scattering cosines of the family's cells, for the positions computed per step.
@@ -71,9 +71,7 @@ void BlendSlab(const TransportContext& tc, const Table& Jin, const Family::Corne
     if (s < tc.loglin_first) {
       Gather16(v, c.w, 0, 4, n, out);
     } else {
-      Gather16(v, c.w, 0, 2, n, &x->lo[s * n]);
-      Gather16(v, c.w, 2, 4, n, &x->hi[s * n]);
-      for (size_t e = 0; e < n; ++e) out[e] = x->lo[s * n + e] + x->hi[s * n + e];
+      GatherLoHi(v, c.w, n, &x->lo[s * n], &x->hi[s * n], out);
     }
   }
 }
@@ -89,19 +87,18 @@ void AccumulateCells(const TransportContext& tc, const std::vector<float>& cfac,
     size_t sofs[4];
     SunAzimuthCorners(p, so, nphi, ws, sofs);
     const bool loglin = p.si >= tc.loglin_first && p.ts > 0.0f;
-    float* jvp = x->jv.data();
+    float* a = &x->acc[cell * nw];
     if (!loglin) {
       const float* v[4] = {&x->slab[sofs[0] * nw], &x->slab[sofs[1] * nw], &x->slab[sofs[2] * nw], &x->slab[sofs[3] * nw]};
-      Gather16(v, ws, 0, 4, nw, jvp);
+      AccumulateCorners4(v, ws, gm, nw, a);
     } else {
       const float* vl[4] = {&x->lo[sofs[0] * nw], &x->lo[sofs[1] * nw], &x->lo[sofs[2] * nw], &x->lo[sofs[3] * nw]};
       const float* vh[4] = {&x->hi[sofs[0] * nw], &x->hi[sofs[1] * nw], &x->hi[sofs[2] * nw], &x->hi[sofs[3] * nw]};
-      Gather16(vl, ws, 0, 4, nw, jvp);
-      Gather16(vh, ws, 0, 4, nw, x->jv2.data());
-      LogBlend(tc, cfac, p, r0, jvp, x->jv2.data());
+      const float *c0, *c1;
+      float tb;
+      LogLinBins(tc, cfac, p, r0, &c0, &c1, &tb);
+      AccumulateCorners4LogLin(vl, vh, ws, c0, c1, tb, gm, nw, a);
     }
-    float* a = &x->acc[cell * nw];
-    for (size_t w = 0; w < nw; ++w) a[w] += gm[w] * jvp[w];
   }
 }
 
