@@ -441,11 +441,12 @@ TEST(MethodOrders, WavelengthBatchesAreTheSameSky) {
   const TestScene sc = LoadTestScene("hazed");
   ViewSegment seg;
   seg.max_distance_m = 20e3;
-  auto sky = [&](int mib, const std::string& batches) {
+  auto sky = [&](int mib, const std::string& batches, int positions_mib = 0) {
     SkyMethodOptions o;
     o.quality = Quality::kLow;
     o.segments = true;
     if (mib > 0) o.table_size["solve_tables_mib"] = mib;
+    if (positions_mib > 0) o.table_size["step_positions_mib"] = positions_mib;
     const std::unique_ptr<SkyMethod> m = MakeSkyMethod("orders", sc.model, o, {});
     EXPECT_NE(m->Describe().find("wavelength_batches: " + batches + "\n"), std::string::npos) << m->Describe();
     std::vector<double> y, more;
@@ -457,11 +458,16 @@ TEST(MethodOrders, WavelengthBatchesAreTheSameSky) {
     return y;
   };
   const std::vector<double> one = sky(0, "1"), three = sky(6, "3"), each = sky(1, "20");
+  // 12 MiB: batches of 16 and 6 solved; with 1 MiB of step positions the smaller batch stores
+  // more radius nodes' positions than the larger (the 7 MiB its tables leave), the same sky.
+  const std::vector<double> two_few = sky(12, "2", 1);
   ASSERT_EQ(one.size(), 3 * SkyDirs().size() * sc.model.wavelengths());
   ASSERT_EQ(one.size(), each.size());
+  ASSERT_EQ(one.size(), two_few.size());
   for (size_t i = 0; i < one.size(); ++i) {
     ASSERT_EQ(one[i], three[i]) << i;
     ASSERT_EQ(one[i], each[i]) << i;
+    ASSERT_EQ(one[i], two_few[i]) << i;
   }
 }
 

@@ -50,11 +50,19 @@ SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, 
                                     const OrdersSettings& s, bool keep_sources, const ProgressFn& progress) {
   const std::vector<WavelengthBatch> batches = PlanWavelengthBatches(md, nodes, s, keep_sources);
   if (batches.size() == 1) return SolveOrders(m, md, sun, nodes, s, keep_sources, progress);
-  const size_t nw = md.nw;
+  const size_t nw = md.nw, per_w = TableBytesPerWavelength(nodes, s, keep_sources);
+  size_t largest = 0;
+  for (const WavelengthBatch& wb : batches) largest = std::max(largest, wb.solve.size());
   SolveResult out;
   out.wavelength_batches = batches.size();
   for (size_t b = 0; b < batches.size(); ++b) {
     const WavelengthBatch& wb = batches[b];
+    // A smaller batch's tables leave memory under the largest one's peak: its step positions
+    // take it, so that more radius nodes' positions are stored instead of computed every order
+    // (the same bytes: MethodOrders.StoredAndComputedStepPositionsAreTheSameSky).
+    OrdersSettings sb_settings = s;
+    const size_t freed_mib = ((largest - wb.solve.size()) * per_w) >> 20;
+    sb_settings.step_positions_mib = static_cast<int>(std::min<size_t>(4096, static_cast<size_t>(s.step_positions_mib) + freed_mib));
     const Medium mb = SliceMedium(md, wb.solve);
     const SunTables sb = SliceSunTables(sun, wb.solve);
     Nodes nb = nodes;
@@ -63,7 +71,7 @@ SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, 
     const ProgressFn batch_progress = [&](std::string_view what, double fraction) {
       ReportProgress(progress, stage + std::string(what), fraction);
     };
-    const SolveResult r = SolveOrders(m, mb, sb, nb, s, keep_sources, batch_progress);
+    const SolveResult r = SolveOrders(m, mb, sb, nb, sb_settings, keep_sources, batch_progress);
     if (b == 0) {
       out.orders_done = r.orders_done, out.tail = r.tail, out.last_fraction = r.last_fraction;
       out.ms.assign(r.ms.size() / nb.nw * nw, 0.0f);
