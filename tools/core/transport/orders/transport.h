@@ -131,9 +131,9 @@ void TransportSplit(const TransportContext& tc, const Table& Jin, const Table& L
 // corners) and jhi (the upper's) each times its factor at the step's sun interval, interpolated
 // between the kLogBins + 1 tabulated t; the result in jlo.
 std::vector<float> LogLinFactors(const TransportContext& tc, const Table& Jin);
-// The factors' two tabulated bins around position p's t for the lower radius r0 (*c0) and the
-// one above (*c1), each kLogBins + 1 rows of nw apart from the next bin, and t's place *tb
-// between them.
+// The factors at the tabulated bin b0 below position p's t, for the lower radius r0 (*c0) and
+// the one above (*c1), each with bin b0 + 1's row nw floats after it, and t's place *tb between
+// the two bins.
 void LogLinBins(const TransportContext& tc, const std::vector<float>& cfac, const SunAzimuth& p, size_t r0, const float** c0,
                 const float** c1, float* tb);
 void LogBlend(const TransportContext& tc, const std::vector<float>& cfac, const SunAzimuth& p, size_t r0, float* jlo, const float* jhi);
