@@ -32,34 +32,49 @@ int main(int argc, char** argv) {
   ToolCli cli("bench_test_references", "A cached path reference for the sky-method tests (tests/transport/references/).");
   std::string atmosphere = "cloudy1", out;
   double sun_zenith = 30.0, target = 0.01;
+  uint64_t max_paths = uint64_t{1} << 20, seed = 1;
+  std::vector<size_t> only;
   cli.app().add_option("--atmosphere", atmosphere, "Atmosphere (atmospheres/<name>.yaml)");
   cli.app().add_option("--sun-zenith-deg", sun_zenith, "Sun zenith angle (deg)")->check(CLI::Range(0.0, 120.0));
   cli.app().add_option("--target-error", target, "Relative standard error of Y per direction")->check(CLI::Range(0.001, 0.5));
+  cli.app().add_option("--max-paths", max_paths, "Path cap per direction (deep twilight needs more than the default 2^20)")
+      ->check(CLI::Range(uint64_t{1024}, uint64_t{1} << 30));
+  cli.app().add_option("--seed", seed, "Path tracer seed (another seed: an independent estimate)");
+  cli.app().add_option("--directions", only, "Only these directions (indices 0-9 into the tests' ten), a check; the file then holds only them")
+      ->check(CLI::Range(size_t{0}, size_t{9}))
+      ->delimiter(',');
   cli.app().add_option("-o,--output", out, "Output CSV")->required();
   return cli.Run(argc, argv, [&] {
     const TestScene sc = LoadTestScene(atmosphere);
     PathTracerSettings ps;
     ps.target_relative_error = target;
     ps.min_paths = 1024;
+    ps.max_paths = max_paths;
+    ps.seed = seed;
     const PathTracer pt(sc.model, sc.weights, ps);
     const glm::dvec3 x(0, 0, sc.model.bottom_radius_m + 1.0), sun = DirectionFromAngles(sun_zenith * kDeg, 0.0);
     const std::vector<std::array<double, 3>>& dirs = SkyDirs();
+    if (only.empty()) {
+      for (size_t d = 0; d < dirs.size(); ++d) only.push_back(d);
+    }
     std::vector<ColorEstimate> est(dirs.size());
     std::vector<double> seconds(dirs.size());
-    tbb::parallel_for(size_t{0}, dirs.size(), size_t{1}, [&](size_t d) {
+    tbb::parallel_for(size_t{0}, only.size(), size_t{1}, [&](size_t k) {
+      const size_t d = only[k];
       const auto t0 = std::chrono::steady_clock::now();
       est[d] = pt.Radiance(x, glm::dvec3(dirs[d][0], dirs[d][1], dirs[d][2]), sun, 300 + d);
       seconds[d] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     });
     std::string text = fmt::format(
-        "# source: bench_test_references --atmosphere {} --sun-zenith-deg {} --target-error {} (path tracer, seed {}, "
+        "# source: bench_test_references --atmosphere {} --sun-zenith-deg {} --target-error {}{} (path tracer, seed {}, "
         "streams 300 + direction; the tests' scene, tests/transport/method_scenes.h); Y in cd/m^2, cpu_s on one thread\n",
-        atmosphere, sun_zenith, target, ps.seed);
+        atmosphere, sun_zenith, target, max_paths == (uint64_t{1} << 20) ? std::string() : fmt::format(" --max-paths {}", max_paths),
+        ps.seed);
     text += "# scene:";
     for (double v : SceneFingerprint(sc)) text += fmt::format(" {:.9e}", v);
     text += "\ntheta_deg,phi_deg,Y_cd_m2,Y_stderr_cd_m2,paths,cpu_s\n";
     double total = 0.0;
-    for (size_t d = 0; d < dirs.size(); ++d) {
+    for (size_t d : only) {
       const double rel = est[d].xyz_stderr[1] / est[d].xyz[1];
       text += fmt::format("{},{},{:.9e},{:.6e},{},{:.1f}\n", SkyAngles()[d][0], SkyAngles()[d][1], est[d].xyz[1],
                           est[d].xyz_stderr[1], est[d].paths, seconds[d]);
