@@ -157,10 +157,10 @@ TEST(OrdersOverrides, TwilightSplitParts) {
   EXPECT_EQ(p.day.sun_deg.size(), 22u);
   EXPECT_EQ(p.day.sun_deg.back(), 93.0);
   EXPECT_EQ(std::vector<int>({p.day.nup, p.day.ndn, p.day.nphi, p.day.kernel_sub}), std::vector<int>({24, 12, 36, 4}));
-  EXPECT_EQ(p.twilight.sun_deg.size(), 29u);
-  EXPECT_EQ(p.twilight.sun_deg.front(), 85.0);
+  EXPECT_EQ(p.twilight.sun_deg.size(), 26u);
+  EXPECT_EQ(p.twilight.sun_deg.front(), 88.0);
   EXPECT_EQ(std::vector<int>({p.twilight.nup, p.twilight.ndn, p.twilight.nphi, p.twilight.kernel_sub, p.twilight.nr, p.twilight.nss}),
-            std::vector<int>({24, 12, 8, 0, 16, 96}));
+            std::vector<int>({24, 12, 16, 0, 16, 96}));
   EXPECT_EQ(p.twilight.truncation_deg, 5.0);
   EXPECT_EQ(p.twilight.truncation_min_deg, 5.0);
   EXPECT_EQ(orders::TwilightWeight(s, 90.0 * kDeg), 0.0);
@@ -172,6 +172,8 @@ TEST(OrdersOverrides, TwilightSplitParts) {
   EXPECT_EQ(UsageMessage([&] { orders::SettingsFor(o); }), "orders: fewer than 2 sun nodes in a part of the twilight split");
   o.table_size = {{"split_from_deg", 0}, {"split_day_to_deg", 90}};
   EXPECT_EQ(orders::SettingsFor(o).split_from_deg, 0.0);
+  o.table_size = {{"split_azimuth", 12}};
+  EXPECT_EQ(orders::SplitParts(orders::SettingsFor(o)).twilight.nphi, 12);
 }
 
 // The preset tables hold the documented values (docs/sky-methods.md, "Qualities").
@@ -196,7 +198,8 @@ TEST(Presets, OrdersTable) {
   EXPECT_EQ(hi.truncation_min_deg, 1.0);
   // The twilight split (transport/orders/split.h): high only.
   EXPECT_EQ(std::vector<double>({hi.split_from_deg, hi.split_width_deg, hi.split_day_to_deg, hi.split_twilight_from_deg}),
-            std::vector<double>({90.0, 1.0, 93.0, 85.0}));
+            std::vector<double>({90.0, 1.0, 93.0, 88.0}));
+  EXPECT_EQ(hi.split_azimuths, 16);
   EXPECT_EQ(lo.split_from_deg, 0.0);
   EXPECT_EQ(me.split_from_deg, 0.0);
   // Radius nodes by the column's optical depth (docs/sky-methods.md "Radius nodes under a cloud"):

@@ -23,19 +23,21 @@ const QualityTable<OrdersSettings>& OrdersPresets() {
       // (split.h; docs/sky-methods.md "The twilight split"): these tables with the sun nodes to
       // 93 deg (22 of the 42: the tables to 92 deg move the sky at sun 90 deg by up to 0.1 %, to 93
       // deg by <= 0.006 %, in Y over 77 directions of the hazed sky on the 20 nm test grid, against
-      // one solve of all 42), and medium's azimuths, kernel and cones with high's view nodes from
-      // 85 deg (29 nodes; from 80 deg the same to 0.001 % RMS, from 0 deg <= 0.11 % closer to the
-      // one solve at sun 90-105 deg), blended over sun zenith 90-91 deg. The twilight tables are
-      // 0.86 / 1.35 / 1.63 % RMS (max 2.5 / 3.2 / 4.1 %) from one solve at high at sun 92 / 95 /
-      // 100 deg there; medium's view nodes would put the ground 1 deg below the horizon at 5x the
-      // one solve's radiance (its first down node is 1.8 deg below the horizon, high's 0.7 deg).
+      // one solve of all 42), and 16 azimuths with medium's kernel and cones and high's view nodes
+      // from 88 deg (26 nodes; from 85 deg the same to 0.01 % RMS), blended over sun zenith 90-91
+      // deg. The twilight tables are within 1.0 % RMS (max 2.6 %) of one solve at high at sun
+      // 91-105 deg over 77 directions of the clear, hazed, cloudy1 and cloudy3 skies on the 20 nm
+      // test grid; with medium's 8 azimuths 2.5 % RMS (max 7.5 %: the horizon band 90 deg from
+      // the sun's azimuth, and under the clouds 70-80 deg from the zenith towards the sun);
+      // medium's view nodes would put the ground 1 deg below the horizon at 5x the one solve's
+      // radiance (its first down node is 1.8 deg below the horizon, high's 0.7 deg).
       // Under a cloud every interval of the 16 radius nodes holding more than 0.15 of optical depth
       // is split into equal optical-depth pieces, up to 64 nodes (cloudy3: 38 nodes, 0.75 % RMS off
       // its sky with 92 nodes; +2 ... +6.6 % against its 1 % path reference with 16; docs/sky-methods.md
       // "Radius nodes under a cloud").
       OrdersSettings{.radius_dtau = 0.15, .nup = 24, .ndn = 12, .nphi = 36, .nss = 96, .fine = 512, .truncation_deg = 3.0,
                      .truncation_min_deg = 1.0, .sun_nr = 192, .kernel_sub = 4, .tolerance = 3e-4,
-                     .split_from_deg = 90.0, .split_width_deg = 1.0, .split_day_to_deg = 93.0, .split_twilight_from_deg = 85.0},
+                     .split_from_deg = 90.0, .split_width_deg = 1.0, .split_day_to_deg = 93.0, .split_twilight_from_deg = 88.0},
   }};
   return presets;
 }
@@ -77,6 +79,7 @@ const std::vector<OrdersOverride>& OrdersOverrides() {
       {"split_width_x10", K::kScaled, 1, 200, 10.0, &S::split_width_deg},
       {"split_day_to_deg", K::kScaled, 0, 180, 1.0, &S::split_day_to_deg},
       {"split_twilight_from_deg", K::kScaled, 0, 180, 1.0, &S::split_twilight_from_deg},
+      {"split_azimuth", K::kCount, 2, kMany, 1.0, &S::split_azimuths},
       {"step_positions_mib", K::kCount, 0, kMany, 1.0, &S::step_positions_mib},
       {"solve_tables_mib", K::kCount, 1, kMany, 1.0, &S::solve_tables_mib},
       {"kernel_half", K::kFlag, 0, 1, 1.0, &S::kernel_half},

@@ -100,13 +100,14 @@ struct OrdersSettings {
   double sun_max_deg = 180.0;
   // The twilight split (split.h; docs/sky-methods.md "The twilight split"): 0 = one solve over
   // every sun node; > 0 = two solves, the daylight one at these settings with its sun nodes up to
-  // split_day_to_deg, the twilight one at medium's angular resolution (view, azimuth, kernel,
-  // cones) with its sun nodes from split_twilight_from_deg, the answers blended from the daylight
-  // to the twilight part over sun zenith split_from_deg to split_from_deg + split_width_deg.
+  // split_day_to_deg, the twilight one with split_azimuths azimuths and medium's kernel and cones
+  // with its sun nodes from split_twilight_from_deg, the answers blended from the daylight to the
+  // twilight part over sun zenith split_from_deg to split_from_deg + split_width_deg.
   double split_from_deg = 0.0;
   double split_width_deg = 1.0;
   double split_day_to_deg = 0.0;
   double split_twilight_from_deg = 0.0;
+  int split_azimuths = 16;
   std::vector<double> sun_deg = {};  // sun zenith nodes (SettingsFor)
 };
 

@@ -11,13 +11,15 @@ SplitSettings SplitParts(const OrdersSettings& s) {
   p.day.split_from_deg = 0.0;
   p.day.sun_max_deg = std::min(s.sun_max_deg, s.split_day_to_deg);
   p.day.sun_deg = SunNodes(p.day);
-  // Medium's azimuths, kernel and cones (its truncation_min_deg 0 reads as its truncation_deg, as
-  // in SettingsFor); high's view nodes, whose first one below the horizon resolves the ground's
-  // dark band 1-2 deg down (docs/sky-methods.md, "The twilight split").
+  // split_azimuths azimuths (16: at 8 the twilight sky's horizon band 90 deg from the sun's
+  // azimuth was up to 5 % above the one solve's) with medium's kernel and cones (its
+  // truncation_min_deg 0 reads as its truncation_deg, as in SettingsFor); high's view nodes,
+  // whose first one below the horizon resolves the ground's dark band 1-2 deg down
+  // (docs/sky-methods.md, "The twilight split").
   const OrdersSettings& med = OrdersPresets()[Quality::kMedium];
   OrdersSettings& t = p.twilight;
   t.split_from_deg = 0.0;
-  t.nphi = med.nphi;
+  t.nphi = s.split_azimuths;
   t.kernel_sub = med.kernel_sub;
   t.truncation_deg = med.truncation_deg;
   t.truncation_min_deg = med.truncation_min_deg > 0.0 && med.truncation_min_deg <= med.truncation_deg ? med.truncation_min_deg : med.truncation_deg;

@@ -1,11 +1,11 @@
 // The twilight split of `orders` (OrdersSettings::split_from_deg > 0; docs/sky-methods.md "The
 // twilight split"): `high` is needed in daylight only (the target there: RMS <= 0.5 %, max <= 2 %
-// against the path tracer), while in twilight (sun zenith 90-110 deg) the target is 3 % RMS and
-// `medium`'s azimuthal resolution is within it; yet 24 of the 42 sun nodes are twilight ones. So
-// the method solves twice: the daylight part at the preset's settings with its sun nodes up to
-// split_day_to_deg, the twilight part at medium's azimuth, kernel and cone settings (the preset's
-// otherwise, its view nodes among them: medium's blur the ground's dark band 1-2 deg below the
-// horizon) with its sun nodes from split_twilight_from_deg. Each answer comes from the
+// against the path tracer), while in twilight (sun zenith 90-110 deg) the target is 3 % RMS; yet
+// 24 of the 42 sun nodes are twilight ones. So the method solves twice: the daylight part at the
+// preset's settings with its sun nodes up to split_day_to_deg, the twilight part with
+// split_azimuths azimuths and medium's kernel and cone settings (the preset's otherwise, its view
+// nodes among them: medium's blur the ground's dark band 1-2 deg below the horizon) with its sun
+// nodes from split_twilight_from_deg. Each answer comes from the
 // daylight part up to split_from_deg, from the twilight part beyond split_from_deg +
 // split_width_deg, and from both in between, blended with a weight smooth in the sun zenith, so
 // that a LUT's sun slices have no jump where the parts meet.
