@@ -172,9 +172,18 @@ void SegmentSource(const RenderInputs& in, const ViewPoint& pt, double mus, doub
   nodes.Interpolate(in.res->jms, rv, SunAzimuth{sa.si, sa.q0, 0.0f, sa.tq}, 1.0, x->jv.data());
   if (sa.ts > 0.0f) {
     nodes.Interpolate(in.res->jms, rv, SunAzimuth{static_cast<uint16_t>(sa.si + 1), sa.q0, 0.0f, sa.tq}, 1.0, x->jv1.data());
+    // a^(1-t) b^t in float with ExpF/LogF, which vectorise (powf is a library call per
+    // wavelength); linear where either is 0 or subnormal (LogF's value there is unspecified but
+    // finite, and the select drops it).
+    const float t = sa.ts;
+    float* jv = x->jv.data();
+    const float* jv1 = x->jv1.data();
     for (size_t w = 0; w < nw; ++w) {
-      const float a = x->jv[w], b = x->jv1[w];
-      x->jv[w] = a > 0.0f && b > 0.0f ? a * std::pow(b / a, sa.ts) : a + (b - a) * sa.ts;
+      const float a = jv[w], b = jv1[w];
+      const bool ok = (a >= std::numeric_limits<float>::min()) & (b >= std::numeric_limits<float>::min());
+      const float geo = ExpF((1.0f - t) * LogF(a) + t * LogF(b));
+      const float lin = a + (b - a) * t;
+      jv[w] = ok ? geo : lin;
     }
   }
 }
