@@ -143,8 +143,8 @@ TEST(OrdersOverrides, EachKindSetsItsSetting) {
 }
 
 // The twilight split's parts: the daylight one with high's tables and its sun nodes to 93 deg,
-// the twilight one with high's view nodes, medium's azimuths, kernel and cones and its sun nodes
-// from 85 deg;
+// the twilight one with high's view nodes, 16 azimuths, medium's kernel and cones and its sun
+// nodes from 88 deg;
 // a split whose parts do not reach across the blend zone is an error.
 TEST(OrdersOverrides, TwilightSplitParts) {
   SkyMethodOptions o;

@@ -89,9 +89,9 @@ class OrdersMethod : public SkyMethod {
   std::string Describe() const override {
     if (!twilight_) return "method: orders\n" + day_->Describe("");
     return fmt::format(
-               "method: orders\ntwilight_split: the daylight tables to sun zenith {} deg, the twilight tables (medium's "
-               "azimuths, kernel and cones) beyond {} deg, blended between\n",
-               s_.split_from_deg, s_.split_from_deg + s_.split_width_deg) +
+               "method: orders\ntwilight_split: the daylight tables to sun zenith {} deg, the twilight tables ({} azimuths, "
+               "medium's kernel and cones) beyond {} deg, blended between\n",
+               s_.split_from_deg, s_.split_azimuths, s_.split_from_deg + s_.split_width_deg) +
            day_->Describe("") + twilight_->Describe("twilight_");
   }
 
