@@ -474,6 +474,63 @@ TEST(MethodOrders, WavelengthBatchesAreTheSameSky) {
     ASSERT_EQ(one[i], each[i]) << i;
     ASSERT_EQ(one[i], two_few[i]) << i;
   }
+  // A sky alone (the solve in place: two fields per cell, the observer's codes) in batches of
+  // one wavelength and the reference, against its one solve and the sky of the solve above.
+  auto sky_alone = [&](int mib) {
+    SkyMethodOptions o;
+    o.quality = Quality::kLow;
+    if (mib > 0) o.table_size["solve_tables_mib"] = mib;
+    const std::unique_ptr<SkyMethod> m = MakeSkyMethod("orders", sc.model, o, {});
+    EXPECT_NE(m->Describe().find(mib > 0 ? "wavelength_batches: 20\n" : "wavelength_batches: 1\n"), std::string::npos)
+        << m->Describe();
+    std::vector<double> y, more;
+    m->Radiance(1.0, 60.0 * kDeg, SkyDirs(), &y);
+    m->Radiance(1.0, 95.0 * kDeg, SkyDirs(), &more);
+    y.insert(y.end(), more.begin(), more.end());
+    return y;
+  };
+  const std::vector<double> alone = sky_alone(0), alone_each = sky_alone(1);
+  ASSERT_EQ(alone.size(), 2 * SkyDirs().size() * sc.model.wavelengths());
+  for (size_t i = 0; i < alone.size(); ++i) {
+    ASSERT_EQ(alone[i], alone_each[i]) << i;
+    ASSERT_EQ(alone[i], one[i]) << i;
+  }
+}
+
+// A sky alone (no view segments) transports each order into L in place and keeps the observer's
+// L_{n-1} aside (solve.cpp, OrderTables); with segments the solve keeps L, J and L_next and the
+// ratio codes of every element. The two forms give the same bytes, with each of the tails: the
+// per-element one (hazed), the dominant mode's at the cap (hazed, 5 orders, no early tail) and
+// the two modes' (cloudy5's deck).
+TEST(MethodOrders, InPlaceSolveIsTheKeptSourcesSolve) {
+  struct Case {
+    const char* atmosphere;
+    std::map<std::string, int> overrides;
+    int orders;
+    const char* tail;  // Describe()'s tail_extrapolated line
+  };
+  const Case cases[] = {{"hazed", {}, 0, "tail_extrapolated: true\n"},
+                        {"hazed", {{"early_tail", 0}}, 5, "tail_extrapolated: true (dominant mode)\n"},
+                        {"cloudy5", {}, 0, "tail_extrapolated: true (two modes)\n"}};
+  const std::vector<std::array<double, 3>> dirs = {Dir(0, 0), Dir(60, 90), Dir(88, 180), Dir(95, 30)};
+  for (const Case& c : cases) {
+    const TestScene sc = LoadTestScene(c.atmosphere);
+    SkyMethodOptions o;
+    o.quality = Quality::kLow;
+    o.table_size = c.overrides;
+    o.orders = c.orders;
+    const std::unique_ptr<SkyMethod> sky = MakeSkyMethod("orders", sc.model, o, {});
+    o.segments = true;
+    const std::unique_ptr<SkyMethod> kept = MakeSkyMethod("orders", sc.model, o, {});
+    EXPECT_NE(sky->Describe().find(c.tail), std::string::npos) << c.atmosphere << ":\n" << sky->Describe();
+    EXPECT_EQ(sky->Describe(), kept->Describe()) << c.atmosphere;
+    for (double sun_deg : {30.0, 85.0, 95.0}) {
+      std::vector<double> a, b;
+      sky->Radiance(0.0, sun_deg * kDeg, dirs, &a);
+      kept->Radiance(0.0, sun_deg * kDeg, dirs, &b);
+      EXPECT_EQ(a, b) << c.atmosphere << " sun " << sun_deg;
+    }
+  }
 }
 
 // The sun on the horizon: inside the table build a table ray's sources are blended between the

@@ -1,4 +1,4 @@
-// The solve's tables (transport/orders/grid.h): ZeroTable gives n zeros whichever way the block
+// The solve's tables (transport/orders/grid.h, the batch size of solve.h): ZeroTable gives n zeros whichever way the block
 // is allocated - from operator new below kMapFrom bytes, zeroed in parallel, or as a fresh
 // mapping from kMapFrom, which the kernel zeroes and ZeroTable does not write - also when the
 // table held other values before.
@@ -8,6 +8,7 @@
 #include <cstddef>
 
 #include "transport/orders/grid.h"
+#include "transport/orders/solve.h"
 
 namespace skybake::orders {
 namespace {
@@ -48,6 +49,25 @@ TEST(OrdersTables, MappedTablesCopyAndSwapLikeVectors) {
   b.clear();
   b.shrink_to_fit();
   EXPECT_EQ(c[n - 1], 1.5f);
+}
+
+// The wavelengths per batch (solve.h): all where they fit; a multiple of 8 where 8 fit; the
+// fewest batches shared evenly, so that no last batch holds one wavelength and the reference
+// (25 of which 24 fit: 16 and 9 with the reference, not 24 and 1).
+TEST(OrdersTables, BatchSizeSharesTheWavelengthsEvenly) {
+  EXPECT_EQ(BatchSize(25, 25), 25u);
+  EXPECT_EQ(BatchSize(25, 1000), 25u);
+  EXPECT_EQ(BatchSize(25, 24), 16u);
+  EXPECT_EQ(BatchSize(25, 17), 16u);
+  EXPECT_EQ(BatchSize(41, 40), 24u);  // 24 and 17 with the reference
+  EXPECT_EQ(BatchSize(21, 8), 8u);    // 8, 8 and 7, each with the reference
+  EXPECT_EQ(BatchSize(21, 16), 16u);  // 16 and 5 + 1
+  EXPECT_EQ(BatchSize(21, 1), 2u);    // one wavelength and the reference
+  EXPECT_EQ(BatchSize(21, 0), 2u);
+  EXPECT_EQ(BatchSize(21, 6), 6u);    // 5 + 1, 6, 5 + 1, 5 + 1
+  EXPECT_EQ(BatchSize(2, 0), 2u);
+  EXPECT_EQ(BatchSize(1, 0), 1u);
+  EXPECT_EQ(BatchSize(95, 70), 48u);  // 48 and 47 + 1, not 64 and 31 + 1
 }
 
 }  // namespace

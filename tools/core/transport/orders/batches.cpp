@@ -13,24 +13,37 @@ namespace skybake::orders {
 
 namespace {
 
-// The solve's tables per wavelength (bytes): L, J, L_next (float) and the ratio codes (one byte)
-// per cell, J_ms (float) when kept, and the kernels.
+// The solve's tables per wavelength (bytes): with kept sources L, J, L_next and J_ms (float) and
+// the ratio codes (one byte) per cell; without, L and J (L_n is transported in place, solve.cpp's
+// OrderTables, and the observer's slabs are a radius node's share); and the kernels.
 size_t TableBytesPerWavelength(const Nodes& nodes, const OrdersSettings& s, bool keep_sources) {
   const size_t cells = nodes.radius.size() * nodes.ns * nodes.nu * static_cast<size_t>(s.nphi);
-  return cells * (3 * sizeof(float) + sizeof(uint8_t) + (keep_sources ? sizeof(float) : 0)) + KernelBytesPerWavelength(nodes, s);
+  const size_t per_cell = keep_sources ? 4 * sizeof(float) + sizeof(uint8_t) : 2 * sizeof(float);
+  return cells * per_cell + KernelBytesPerWavelength(nodes, s);
 }
 
 }  // namespace
 
+size_t BatchSize(size_t nw, size_t fit) {
+  if (fit >= nw || nw <= 2) return nw;
+  // A multiple of 8 where 8 fit: the solve's products run 8 wavelengths wide (simd.h), and a
+  // batch's rows of J are then whole vectors (16 floats: one cache line per corner of the
+  // gather). Measured on cloudy4's LUT (25 wavelengths): batches of 16 and 10 257 s, of 13 and 13
+  // 346 s, one solve 171 s.
+  size_t size = std::max<size_t>(2, fit >= 8 ? fit / 8 * 8 : fit);
+  // As few batches as that size needs, the wavelengths shared evenly among them (each batch but
+  // the reference's also solves the reference), rounded up to a multiple of 8: a last batch of a
+  // wavelength or two would cost a whole pass of the orders (an order costs nearly the same at 10
+  // wavelengths as at 17: docs/sky-methods.md "Measured speed").
+  const size_t batches = (nw - 1 + size - 2) / (size - 1);
+  size_t even = (nw + batches - 1 + batches - 1) / batches;
+  if (size >= 8) even = (even + 7) / 8 * 8;
+  return std::min(size, even);
+}
+
 std::vector<WavelengthBatch> PlanWavelengthBatches(const Medium& md, const Nodes& nodes, const OrdersSettings& s, bool keep_sources) {
   const size_t nw = md.nw, per_w = TableBytesPerWavelength(nodes, s, keep_sources);
-  const size_t fit = (static_cast<size_t>(s.solve_tables_mib) << 20) / per_w;  // wavelengths whose tables fit
-  // One batch of every wavelength where they all fit; else batches of a multiple of 8 wavelengths
-  // solved (the reference among them) where 8 fit: the solve's products run 8 wavelengths wide
-  // (simd.h), and a batch's rows of J are then whole vectors (16 floats: one cache line per
-  // corner of the gather). Measured on cloudy4's LUT (25
-  // wavelengths): batches of 16 and 10 257 s, of 13 and 13 346 s, one solve 171 s.
-  const size_t per_batch = fit >= nw ? nw : std::max<size_t>(2, fit >= 8 ? fit / 8 * 8 : fit);
+  const size_t per_batch = BatchSize(nw, (static_cast<size_t>(s.solve_tables_mib) << 20) / per_w);
   std::vector<WavelengthBatch> batches;
   for (size_t first = 0; first < nw;) {
     WavelengthBatch wb;

@@ -81,12 +81,16 @@ struct OrdersSettings {
   double tail_share_max = 0.1;
   // Memory for the step positions stored between orders (TransportContext::sun_az, MiB): the
   // radius nodes whose positions fit are stored, the others' computed per lookup, with the same
-  // bytes ("Peak memory" in docs/sky-methods.md).
-  int step_positions_mib = 256;
+  // bytes ("Peak memory" in docs/sky-methods.md). 288: all 65 of a thick sky's radius nodes at
+  // high (4.35 MiB each, 283 MiB), whose computed positions would cost ~28 ms per node and order.
+  int step_positions_mib = 288;
   // Memory for the solve's per-wavelength tables (the fields, the ratio codes, the kernels, J_ms;
   // MiB): above it the wavelengths are solved in batches that fit, with the same bytes
-  // (PlanWavelengthBatches in solve.h; "Peak memory" in docs/sky-methods.md).
-  int solve_tables_mib = 640;
+  // (PlanWavelengthBatches in solve.h; "Peak memory" in docs/sky-methods.md). 600: a thick sky's
+  // 25 wavelengths at high (~635 MiB) are two batches, whose first one's tables and every step
+  // position peak at 824 MiB; as one solve with every position stored they would peak at 1040
+  // MiB, over the 1 GB target, and with the positions cut to fit it cost as much as two batches.
+  int solve_tables_mib = 600;
   int max_orders = 40;
   double tolerance = 1e-3;
   // The sun zenith nodes' spacing (SunNodes in settings.cpp): every sun_step_deg up to 80 deg,

@@ -89,12 +89,32 @@ inline uint8_t RatioCode(float now, float before) {
 }
 inline double RatioOfCode(uint8_t c) { return (c + 0.5) / 254.0; }
 
-// The tables of the iteration: L = L_{n-1} while order n is computed into Lnext; J the sources
-// of order n; ratio the code of L_{n-1} / L_{n-2} per element (for the tail's test).
+// The tables of the iteration; J the sources of order n. With kept sources (view segments read
+// J_ms at every node, and the tail of J_ms needs every element's orders): L = L_{n-1} while
+// order n is computed into Lnext, and ratio the code of L_{n-1} / L_{n-2} per element. Without
+// (a sky reads the observer's radius alone): order n is transported into L in place - the
+// transport reads L_{n-1} only for the ground's irradiance, which it forms first - so the solve
+// holds two fields instead of three ("Peak memory" in docs/sky-methods.md); the observer's slab
+// of L_{n-1} is kept in prev_obs and ratio holds the observer's codes alone. The two forms
+// compute the same values.
 struct OrderTables {
+  bool in_place = false;
   Table L, J, Lnext;
   std::vector<uint8_t> ratio;
+  std::vector<float> prev_obs;  // in place: the observer's L_{n-1}
 };
+
+// The observer radius's elements (ns x nd x nw from `offset`) of L_{n-1}, L_n and the codes of
+// L_{n-1} / L_{n-2}, in either form of the tables.
+struct ObserverOrders {
+  const float* before;
+  const float* now;
+  const uint8_t* code;
+};
+ObserverOrders Observer(const OrderTables& t, size_t offset) {
+  if (t.in_place) return {t.prev_obs.data(), t.L.data() + offset, t.ratio.data()};
+  return {t.L.data() + offset, t.Lnext.data() + offset, t.ratio.data() + offset};
+}
 
 // The ratio history of the stopping rule (norms of successive orders at the observer, reference
 // wavelength; and every wavelength's norm of the last order, for the dominant-mode tail).
@@ -152,32 +172,29 @@ Tail TakeTail(const OrdersSettings& s, int order, double fraction, double ratio,
 //    observer's ratio at the reference wavelength elsewhere (an element whose orders still grow -
 //    the low-sun horizon's at order 4 - would get a tail of 9 L_n from its own ratio and come out
 //    60 % bright).
-// Here Lnext = L_n, L = L_{n-1} and ratio codes L_{n-1} / L_{n-2}.
+// Per element the factor rho / (1 - rho) of its L_n, from L_{n-1} (before), L_n (now) and the
+// code of L_{n-1} / L_{n-2}; the jms part (kept sources only) reads every element of L, Lnext and
+// ratio.
 void AddTail(const Nodes& nodes, const OrdersSettings& s, size_t nd, Tail kind, double ratio, const std::vector<double>& ratio_w,
              const OrderTables& t, SolveResult* out) {
-  const size_t nw = nodes.nw, ns = nodes.ns;
+  const size_t nw = nodes.nw, n = nodes.ns * nd * nw;
   std::vector<float> dominant(nw);
   for (size_t w = 0; w < nw; ++w) {
     const double rho = std::clamp(ratio_w[w], 0.0, s.rho_cap);
     dominant[w] = static_cast<float>(rho / (1.0 - rho));
   }
-  auto tail_at = [&](size_t e) {
-    if (kind == Tail::kDominant) return dominant[e % nw];
-    const double r1 = t.L[e] > 0.0f ? t.Lnext[e] / static_cast<double>(t.L[e]) : 2.0;
-    const uint8_t c0 = t.ratio[e];
+  auto factor = [&](size_t w, float before, float now, uint8_t c0) {
+    if (kind == Tail::kDominant) return dominant[w];
+    const double r1 = before > 0.0f ? now / static_cast<double>(before) : 2.0;
     double rho = r1 < 1.0 && c0 != kRatioNone && std::abs(r1 - RatioOfCode(c0)) < 0.05 ? r1 : ratio;
     rho = std::clamp(rho, 0.0, s.rho_cap);
     return static_cast<float>(rho / (1.0 - rho));
   };
-  for (size_t si = 0; si < ns; ++si) {
-    for (size_t i = 0; i < nd; ++i) {
-      const size_t e0 = (((nodes.obs_index * ns + si) * nd) + i) * nw;
-      float* a = &out->ms[((si * nd) + i) * nw];
-      for (size_t w = 0; w < nw; ++w) a[w] += tail_at(e0 + w) * t.Lnext[e0 + w];
-    }
-  }
+  // ms[j] is the observer's element j (the slab's layout: [(si * nd + i) * nw + w]).
+  const ObserverOrders o = Observer(t, nodes.obs_index * n);
+  for (size_t j = 0; j < n; ++j) out->ms[j] += factor(j % nw, o.before[j], o.now[j], o.code[j]) * o.now[j];
   tbb::parallel_for(tbb::blocked_range<size_t>(0, out->jms.size(), size_t{1} << 18), [&](const tbb::blocked_range<size_t>& rg) {
-    for (size_t i = rg.begin(); i != rg.end(); ++i) out->jms[i] += tail_at(i) * t.J[i];
+    for (size_t i = rg.begin(); i != rg.end(); ++i) out->jms[i] += factor(i % nw, t.L[i], t.Lnext[i], t.ratio[i]) * t.J[i];
   });
   out->tail = kind;
 }
@@ -197,15 +214,15 @@ struct SecondMode {
   double fraction = 1.0;           // sum |D_n| / ((1 - lambda) total) at the reference wavelength
 };
 SecondMode EstimateSecondMode(const Nodes& nodes, size_t nd, size_t wref, double ratio, const std::vector<double>& lambda,
-                              const Table& L, const Table& Lnext, const std::vector<float>& obs_before, double total) {
-  const size_t nw = nodes.nw, n = nodes.ns * nd * nw, e0 = nodes.obs_index * n;
+                              const ObserverOrders& o, const std::vector<float>& obs_before, double total) {
+  const size_t nw = nodes.nw, n = nodes.ns * nd * nw;
   SecondMode m;
   m.lambda = lambda;
   std::vector<double> dn(nw, 0.0), dm(nw, 0.0);
   for (size_t j = 0; j < n; ++j) {
     const size_t w = j % nw;
-    dn[w] += std::abs(Lnext[e0 + j] - m.lambda[w] * L[e0 + j]);
-    dm[w] += std::abs(L[e0 + j] - m.lambda[w] * obs_before[j]);
+    dn[w] += std::abs(o.now[j] - m.lambda[w] * o.before[j]);
+    dm[w] += std::abs(o.before[j] - m.lambda[w] * obs_before[j]);
   }
   m.mu.resize(nw);
   for (size_t w = 0; w < nw; ++w) m.mu[w] = dm[w] > 0.0 ? dn[w] / dm[w] : 0.0;
@@ -226,22 +243,14 @@ void AddTwoModeTail(const KernelContext& kc, const ScatterKernels& sk, const Nod
     b[w] = static_cast<float>(m / ((1.0 - m) * (1.0 - l)));
     lf[w] = static_cast<float>(l);
   }
-  auto tail_at = [&](size_t e) {
-    const size_t w = e % nw;
-    const float ln = t->Lnext[e];
-    return std::max(ln * a[w] + (ln - lf[w] * t->L[e]) * b[w], 0.0f);
-  };
-  for (size_t si = 0; si < ns; ++si) {
-    for (size_t i = 0; i < nd; ++i) {
-      const size_t e0 = (((nodes.obs_index * ns + si) * nd) + i) * nw;
-      float* o = &out->ms[((si * nd) + i) * nw];
-      for (size_t w = 0; w < nw; ++w) o[w] += tail_at(e0 + w);
-    }
-  }
+  auto tail = [&](size_t w, float before, float now) { return std::max(now * a[w] + (now - lf[w] * before) * b[w], 0.0f); };
+  const size_t n = ns * nd * nw;
+  const ObserverOrders o = Observer(*t, nodes.obs_index * n);
+  for (size_t j = 0; j < n; ++j) out->ms[j] += tail(j % nw, o.before[j], o.now[j]);
   out->tail = Tail::kTwoModes;
   if (out->jms.empty()) return;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, t->L.size(), size_t{1} << 18), [&](const tbb::blocked_range<size_t>& rg) {
-    for (size_t i = rg.begin(); i != rg.end(); ++i) t->L[i] = t->Lnext[i] + tail_at(i);
+    for (size_t i = rg.begin(); i != rg.end(); ++i) t->L[i] = t->Lnext[i] + tail(i % nw, t->L[i], t->Lnext[i]);
   });
   Scatter(kc, sk, t->L, &t->J);
   tbb::parallel_for(tbb::blocked_range<size_t>(0, out->jms.size(), size_t{1} << 18), [&](const tbb::blocked_range<size_t>& rg) {
@@ -302,16 +311,19 @@ SolveResult SolveOrders(const AtmosphereModel& m, const Medium& md, const SunTab
   // nothing to the peak.
   const KernelContext kc = MakeKernelContext(md, nodes, s);
   const ScatterKernels sk = BuildScatterKernels(kc);
+  const size_t nd = nodes.nu * nphi;                    // directions per (radius, sun)
+  const size_t n_obs = nodes.ns * nd * nw, obs_offset = nodes.obs_index * n_obs;  // the observer's slab
   OrderTables t;
-  for (Table* x : {&t.L, &t.J, &t.Lnext}) ZeroTable(x, cells * nw);
-  t.ratio.assign(cells * nw, kRatioNone);  // no L_0: the test fails at order 2
+  t.in_place = !keep_sources;
+  for (Table* x : {&t.L, &t.J}) ZeroTable(x, cells * nw);
+  if (!t.in_place) ZeroTable(&t.Lnext, cells * nw);
+  t.ratio.assign(t.in_place ? n_obs : cells * nw, kRatioNone);  // no L_0: the test fails at order 2
   ReportProgress(progress, "orders: order 1", 0.0);
   FirstOrder(m, md, sun, &tc, &t.L);
 
   SolveResult out;
   out.ms.assign(nodes.ns * nodes.nu * nphi * nw, 0.0f);
   if (keep_sources) ZeroTable(&out.jms, cells * nw);
-  const size_t nd = nodes.nu * nphi;  // directions per (radius, sun)
   RatioHistory h;
   std::vector<double> norm_w, ratio_w(nw);
   std::vector<float> obs_before;  // the observer's L_{n-2} (SecondMode)
@@ -322,11 +334,18 @@ SolveResult SolveOrders(const AtmosphereModel& m, const Medium& md, const SunTab
     tbb::parallel_for(tbb::blocked_range<size_t>(0, out.jms.size(), size_t{1} << 18), [&](const tbb::blocked_range<size_t>& rg) {
       for (size_t i = rg.begin(); i != rg.end(); ++i) out.jms[i] += t.J[i];
     });
-    Transport(tc, t.J, t.L, &t.Lnext);
-    // Accumulate L_n (Lnext) at the observer radius; convergence on the reference wavelength
-    // (every decision below reads it, so a wavelength batch that holds it stops as the whole does).
+    if (t.in_place) {
+      const auto from = t.L.begin() + static_cast<std::ptrdiff_t>(obs_offset);
+      t.prev_obs.assign(from, from + static_cast<std::ptrdiff_t>(n_obs));
+      Transport(tc, t.J, t.L, &t.L);
+    } else {
+      Transport(tc, t.J, t.L, &t.Lnext);
+    }
+    const Table& now = t.in_place ? t.L : t.Lnext;  // L_n
+    // Accumulate L_n at the observer radius; convergence on the reference wavelength (every
+    // decision below reads it, so a wavelength batch that holds it stops as the whole does).
     double total = 0.0;
-    const double norm = AccumulateAtObserver(nodes, nd, md.wref, t.Lnext, &out.ms, &total, &norm_w);
+    const double norm = AccumulateAtObserver(nodes, nd, md.wref, now, &out.ms, &total, &norm_w);
     out.orders_done = order;
     out.last_fraction = total > 0.0 ? norm / total : 0.0;
     const double ratio = h.prev_norm > 0.0 ? norm / h.prev_norm : -1.0;
@@ -338,7 +357,7 @@ SolveResult SolveOrders(const AtmosphereModel& m, const Medium& md, const SunTab
       break;
     }
     if (!obs_before.empty() && TwoModesApply(s, order, out.last_fraction, ratio, h)) {
-      const SecondMode sm = EstimateSecondMode(nodes, nd, md.wref, ratio, ratio_w, t.L, t.Lnext, obs_before, total);
+      const SecondMode sm = EstimateSecondMode(nodes, nd, md.wref, ratio, ratio_w, Observer(t, obs_offset), obs_before, total);
       const double mu = sm.mu[md.wref];
       if (TakeTwoModes(s, out.last_fraction, ratio, h, mu, prev_mu, sm.fraction)) {
         AddTwoModeTail(kc, sk, nodes, s, nd, sm, &t, &out);
@@ -352,12 +371,16 @@ SolveResult SolveOrders(const AtmosphereModel& m, const Medium& md, const SunTab
     h.prev_ratio = ratio;
     h.prev_norm = norm;
     h.prev_norm_w = norm_w;
-    if (order >= 3) {
-      const size_t n = nodes.ns * nd * nw;
-      const auto from = t.L.begin() + static_cast<std::ptrdiff_t>(nodes.obs_index * n);
-      obs_before.assign(from, from + static_cast<std::ptrdiff_t>(n));
+    // Next order: the ratio codes L_n / L_{n-1}, the observer's L_{n-1} as its L_{n-2}, L = L_n.
+    if (t.in_place) {
+      for (size_t j = 0; j < n_obs; ++j) t.ratio[j] = RatioCode(t.L[obs_offset + j], t.prev_obs[j]);
+      if (order >= 3) obs_before.swap(t.prev_obs);
+      continue;
     }
-    // Next order: ratio codes L_n / L_{n-1}, then L = L_n.
+    if (order >= 3) {
+      const auto from = t.L.begin() + static_cast<std::ptrdiff_t>(obs_offset);
+      obs_before.assign(from, from + static_cast<std::ptrdiff_t>(n_obs));
+    }
     tbb::parallel_for(tbb::blocked_range<size_t>(0, t.ratio.size(), size_t{1} << 18), [&](const tbb::blocked_range<size_t>& rg) {
       for (size_t i = rg.begin(); i != rg.end(); ++i) t.ratio[i] = RatioCode(t.Lnext[i], t.L[i]);
     });

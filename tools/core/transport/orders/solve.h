@@ -51,9 +51,12 @@ struct WavelengthBatch {
   std::vector<size_t> solve;  // the wavelengths solved (ascending; the reference among them)
   size_t first = 0, end = 0;  // the batch's own wavelengths [first, end), which it answers for
 };
-// Batches of contiguous wavelengths whose tables fit in s.solve_tables_mib: one when all do, else
-// as many wavelengths solved per batch as fit, rounded down to a multiple of 8 (batches.cpp), and
-// at least 2 (one of them the reference).
+// The wavelengths solved per batch, of nw, where the tables of `fit` fit: nw when all do, else
+// as many as fit rounded down to a multiple of 8 (at least 2, one of them the reference), then
+// down to the fewest such batches' even share (rounded up to a multiple of 8): 25 of which 24 fit
+// are batches of 16 and 9 with the reference, not 24 and 1.
+size_t BatchSize(size_t nw, size_t fit);
+// Batches of contiguous wavelengths whose tables fit in s.solve_tables_mib, BatchSize each.
 std::vector<WavelengthBatch> PlanWavelengthBatches(const Medium& md, const Nodes& nodes, const OrdersSettings& s, bool keep_sources);
 
 // SolveOrders over the batches of PlanWavelengthBatches, their results put together.

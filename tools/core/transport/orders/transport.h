@@ -26,9 +26,9 @@ constexpr size_t kLogBins = 16;
 // kNoSun), the azimuth node q0 (bits 6-11) and the weights ts (bits 12-21) and tq (bits 22-31) in
 // 10-bit fixed point, k / 1023 (within 4.9e-4 of the float weight; 0 and 1 exact). 4 bytes per
 // (cell, step) instead of 12 (high's daylight tables: 4.6 MB per radius node), so that the
-// default budget (256 MiB) holds the positions of 58 of the thick skies' 65 radius nodes (all 65
-// in their smaller second wavelength batch, SolveMultipleScattering). Every lookup reads the
-// quantized weights, stored or computed (QuantizeSunAzimuth), so the two give the same bytes. The
+// default budget (288 MiB) holds the positions of all 65 of the thick skies' radius nodes. Every
+// lookup reads the quantized weights, stored or computed (QuantizeSunAzimuth), so the two give
+// the same bytes. The
 // indices fit where a solve has at most 64 sun nodes and 64 azimuths (PositionsPackable); beyond
 // (expert overrides only) every position is computed.
 using PackedSunAzimuth = uint32_t;
