@@ -9,11 +9,13 @@
 //       -o tests/transport/references/cloudy1_sun30.csv    (one command line)
 //
 // Directions run in parallel (--threads); each is one estimate with its own stream, so the file's
-// numbers do not depend on the thread count (its cpu_s column does).
+// numbers do not depend on the thread count. cpu_s is each direction's CPU time on the thread
+// that ran it, which other jobs on the machine do not inflate as they would its wall time.
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
-#include <chrono>
+#include <time.h>
+
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -27,6 +29,17 @@
 
 using namespace skybake;
 using namespace skybake::testing;
+
+namespace {
+
+// The calling thread's CPU time (s): a direction's estimate runs on one thread from start to end.
+double ThreadCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   ToolCli cli("bench_test_references", "A cached path reference for the sky-method tests (tests/transport/references/).");
@@ -61,9 +74,9 @@ int main(int argc, char** argv) {
     std::vector<double> seconds(dirs.size());
     tbb::parallel_for(size_t{0}, only.size(), size_t{1}, [&](size_t k) {
       const size_t d = only[k];
-      const auto t0 = std::chrono::steady_clock::now();
+      const double t0 = ThreadCpuSeconds();
       est[d] = pt.Radiance(x, glm::dvec3(dirs[d][0], dirs[d][1], dirs[d][2]), sun, 300 + d);
-      seconds[d] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      seconds[d] = ThreadCpuSeconds() - t0;
     });
     std::string text = fmt::format(
         "# source: bench_test_references --atmosphere {} --sun-zenith-deg {} --target-error {}{} (path tracer, seed {}, "
