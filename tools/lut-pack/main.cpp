@@ -139,9 +139,9 @@ int main(int argc, char** argv) {
       if (!decode_preview.empty() && !(decode_white > 0.0 && std::isfinite(decode_white))) {
         throw UsageError("--preview needs --white-cd-m2 with a finite positive luminance");
       }
-      const std::optional<Size2> dome = ParseSize(decode_size, 1, 8192);
-      if (!dome) throw UsageError("--size: expected " + SizeExpected(1, 8192, "64x32") + ", got '" + decode_size + "'");
-      const int w = dome->width, h = dome->height;
+      const std::optional<Size2> dome_size = ParseSize(decode_size, 1, 8192);
+      if (!dome_size) throw UsageError("--size: expected " + SizeExpected(1, 8192, "64x32") + ", got '" + decode_size + "'");
+      const int w = dome_size->width, h = dome_size->height;
       for (double z : decode_sza) {
         if (!(z >= 0.0 && z <= 180.0)) throw UsageError(fmt::format("--sun-zenith-deg: {} is not in 0-180", z));
       }

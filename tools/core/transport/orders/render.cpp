@@ -153,8 +153,8 @@ inline float LogLinearBlend(float a, float b, float t) {
   const float ratio = b / a;
   const float geo = a * ExpF(t * LogF(ratio));
   const float lin = a + (b - a) * t;
-  const bool use_geo = (a >= std::numeric_limits<float>::min()) & (b >= std::numeric_limits<float>::min()) & (ratio > 1e-30f) &
-                       (ratio < 1e30f);
+  const int use_geo = static_cast<int>(a >= std::numeric_limits<float>::min()) & static_cast<int>(b >= std::numeric_limits<float>::min()) &
+                      static_cast<int>(ratio > 1e-30f) & static_cast<int>(ratio < 1e30f);
   return use_geo ? geo : lin;
 }
 
