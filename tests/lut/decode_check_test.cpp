@@ -20,6 +20,7 @@
 #include <cstdio>
 #include <algorithm>
 #include <map>
+#include <memory>
 #include <numbers>
 
 #include "atmosphere/mie_optics.h"
@@ -60,10 +61,10 @@ struct Scene {
 // clear.yaml with its OPAC continental aerosol, 400-700 nm in 50 nm steps, CIE 1931 (its XYZ is
 // OCIO's reference space: no observer conversion needed here).
 const Scene& Clear(const std::string& method = "single") {
-  static std::map<std::string, const Scene*> scenes;
+  static std::map<std::string, std::unique_ptr<const Scene>> scenes;  // built once per method, freed at exit
   if (scenes.count(method)) return *scenes[method];
-  const Scene* scene = [&] {
-    auto* s = new Scene;
+  std::unique_ptr<Scene> scene = [&] {
+    auto s = std::make_unique<Scene>();
     AtmosphereSpec spec = LoadAtmosphere(SKYBAKE_SOURCE_DIR "/atmospheres/clear.yaml");
     spec.grid = GridSpec{100.0};
     VerticalProfiles prof = ComputeProfiles(spec);
@@ -82,8 +83,8 @@ const Scene& Clear(const std::string& method = "single") {
     s->spec = spec;
     return s;
   }();
-  scenes[method] = scene;
-  return *scene;
+  scenes[method] = std::move(scene);
+  return *scenes[method];
 }
 
 SkyRenderResult Render(const Scene& sc, std::shared_ptr<const SkyMapping> mapping, std::vector<double> zenith_deg) {
