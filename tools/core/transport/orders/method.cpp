@@ -35,12 +35,12 @@ class OrdersSolve {
         "{0}radius_nodes: {1}\n{0}view_nodes: {2} up + {3} down per altitude\n{0}azimuth_nodes: {4}\n"
         "{0}sun_nodes: {5}\n{0}ray_steps: {6}\n{0}view_steps: {7}\n{0}truncation_deg: {8}\n{0}kernel: {9}\n{0}orders_computed: {10}\n"
         "{0}tail_extrapolated: {11}{15}\n{0}last_order_fraction: {12:.3g}\n{0}tolerance: {13}\n{0}single_scattering_attenuation: {14}\n"
-        "{0}wavelength_batches: {16}\n",
+        "{0}wavelength_batches: {16}\n{0}acceleration: {17}\n",
         prefix, nodes_.radius.size(), s_.nup, s_.ndn, s_.nphi, SunNodesText(), s_.nt, s_.nss, md_.ConesText(),
         s_.kernel_sub > 0 ? fmt::format("basis-integrated, {} sub-intervals", s_.kernel_sub) : std::string("phase at the nodes"),
         res_.orders_done, res_.tail != orders::Tail::kNone ? "true" : "false", res_.last_fraction, s_.tolerance, ss_scaled_ ? "delta-scaled" : "unscaled",
         res_.tail == orders::Tail::kDominant ? " (dominant mode)" : res_.tail == orders::Tail::kTwoModes ? " (two modes)" : "",
-        res_.wavelength_batches);
+        res_.wavelength_batches, fmt::format("{} (scaled column optical depth {:.2f})", res_.accelerated ? "diffusion" : "none", res_.column_depth));
   }
 
   void Render(double observer_altitude_m, double sun_zenith_rad, const std::vector<std::array<double, 3>>& dirs,

@@ -72,6 +72,7 @@ const std::vector<OrdersOverride>& OrdersOverrides() {
       {"rho_cap_pct", K::kScaled, 1, 99, 100.0, &S::rho_cap},
       {"azimuth_even", K::kFlag, 0, 1, 1.0, &S::azimuth_even},
       {"early_tail", K::kFlag, 0, 1, 1.0, &S::early_tail},
+      {"dsa_from_tau_x10", K::kScaled, 0, 10000, 10.0, &S::dsa_from_tau},
       {"sun_step_deg", K::kCount, 1, 80, 1.0, &S::sun_step_deg},
       {"low_sun_step_x10", K::kScaled, 1, 100, 10.0, &S::low_sun_step_deg},
       {"twilight_step_x10", K::kScaled, 1, 200, 10.0, &S::twilight_step_deg},

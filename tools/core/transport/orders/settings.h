@@ -46,6 +46,10 @@ struct OrdersSettings {
   bool normalise = true;     // kernel rows scaled to conserve energy
   bool azimuth_even = true;  // azimuth blends even about the sun's plane (phi^2 near 0 and pi)
   bool early_tail = true;    // stop with the geometric tail once it is accurate to `tolerance`
+  // Diffusion synthetic acceleration of the orders (acceleration.h; docs/sky-methods.md
+  // "Accelerated orders") where the column's delta-scaled vertical optical depth at the reference
+  // wavelength is at least this; 0: never.
+  double dsa_from_tau = 0.0;
   // Scattering kernel: 0 = the phase sampled at the direction nodes (each node standing for its
   // cell); n > 0 = integrated against the interpolation's own basis (the "hat" of each node, linear
   // in the view-node index and in the azimuth blend) with n sub-intervals per view interval and

@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "transport/orders/acceleration.h"
 #include "transport/orders/kernel.h"
 #include "transport/orders/transport.h"
 
@@ -276,9 +277,11 @@ bool TakeTwoModes(const OrdersSettings& s, double fraction, double ratio, const 
 }
 
 // Adds L (order n) at the observer radius to ms; returns its norm at the reference wavelength
-// wref, sets *total to the accumulated one and norm_w to the norm at every wavelength.
-double AccumulateAtObserver(const Nodes& nodes, size_t nd, size_t wref, const Table& L, std::vector<float>* ms, double* total,
-                            std::vector<double>* norm_w) {
+// wref, sets *total to the accumulated one and norm_w to the norm at every wavelength. The norm is
+// the sum of the elements, or of their magnitudes (`magnitude`: an accelerated series, whose
+// increments change sign where a correction overshot).
+double AccumulateAtObserver(const Nodes& nodes, size_t nd, size_t wref, const Table& L, bool magnitude, std::vector<float>* ms,
+                            double* total, std::vector<double>* norm_w) {
   const size_t nw = nodes.nw, ns = nodes.ns;
   double norm = 0.0;
   *total = 0.0;
@@ -289,9 +292,9 @@ double AccumulateAtObserver(const Nodes& nodes, size_t nd, size_t wref, const Ta
       float* a = &(*ms)[((si * nd) + i) * nw];
       for (size_t w = 0; w < nw; ++w) {
         a[w] += v[w];
-        (*norm_w)[w] += v[w];
+        (*norm_w)[w] += magnitude ? std::abs(v[w]) : v[w];
       }
-      norm += v[wref];
+      norm += magnitude ? std::abs(v[wref]) : v[wref];
       *total += a[wref];
     }
   }
@@ -323,7 +326,29 @@ SolveResult SolveOrders(const AtmosphereModel& m, const Medium& md, const SunTab
 
   SolveResult out;
   out.ms.assign(nodes.ns * nodes.nu * nphi * nw, 0.0f);
+  // Diffusion synthetic acceleration under a thick column (acceleration.h); the first order's
+  // correction belongs to the multiple scattering, so ms starts with it at the observer.
+  out.column_depth = ScaledColumnDepth(md, nodes);
+  const bool accelerate = s.dsa_from_tau > 0.0 && out.column_depth >= s.dsa_from_tau;
+  DiffusionAcceleration dsa;
+  out.accelerated = accelerate;
+  if (accelerate) {
+    dsa = MakeDiffusionAcceleration(md, nodes, kc);
+    const std::vector<float> first(t.L.begin() + static_cast<std::ptrdiff_t>(obs_offset),
+                                   t.L.begin() + static_cast<std::ptrdiff_t>(obs_offset + n_obs));
+    Accelerate(&dsa, &t.L);
+    for (size_t j = 0; j < n_obs; ++j) out.ms[j] += t.L[obs_offset + j] - first[j];
+  }
   if (keep_sources) ZeroTable(&out.jms, cells * nw);
+  // An accelerated series' increments are not orders - they change sign where a correction
+  // overshot, and their shape is not the light's - so the twilight factors of its sun blend
+  // come from the sources summed over the orders so far (the light's), not from each increment
+  // (acceleration.h).
+  std::vector<double> jmeans;
+  if (accelerate) {
+    jmeans.assign(nr * nodes.ns * nw, 0.0);
+    tc.loglin_means = &jmeans;
+  }
   RatioHistory h;
   std::vector<double> norm_w, ratio_w(nw);
   std::vector<float> obs_before;  // the observer's L_{n-2} (SecondMode)
@@ -334,18 +359,24 @@ SolveResult SolveOrders(const AtmosphereModel& m, const Medium& md, const SunTab
     tbb::parallel_for(tbb::blocked_range<size_t>(0, out.jms.size(), size_t{1} << 18), [&](const tbb::blocked_range<size_t>& rg) {
       for (size_t i = rg.begin(); i != rg.end(); ++i) out.jms[i] += t.J[i];
     });
+    if (accelerate) {
+      const std::vector<double> g = LogLinMeans(tc, t.J);
+      for (size_t i = 0; i < g.size(); ++i) jmeans[i] += g[i];
+    }
     if (t.in_place) {
       const auto from = t.L.begin() + static_cast<std::ptrdiff_t>(obs_offset);
       t.prev_obs.assign(from, from + static_cast<std::ptrdiff_t>(n_obs));
       Transport(tc, t.J, t.L, &t.L);
+      if (accelerate) Accelerate(&dsa, &t.L);
     } else {
       Transport(tc, t.J, t.L, &t.Lnext);
+      if (accelerate) Accelerate(&dsa, &t.Lnext);
     }
     const Table& now = t.in_place ? t.L : t.Lnext;  // L_n
     // Accumulate L_n at the observer radius; convergence on the reference wavelength (every
     // decision below reads it, so a wavelength batch that holds it stops as the whole does).
     double total = 0.0;
-    const double norm = AccumulateAtObserver(nodes, nd, md.wref, now, &out.ms, &total, &norm_w);
+    const double norm = AccumulateAtObserver(nodes, nd, md.wref, now, accelerate, &out.ms, &total, &norm_w);
     out.orders_done = order;
     out.last_fraction = total > 0.0 ? norm / total : 0.0;
     const double ratio = h.prev_norm > 0.0 ? norm / h.prev_norm : -1.0;

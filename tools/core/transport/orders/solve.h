@@ -33,6 +33,8 @@ struct SolveResult {
   Tail tail = Tail::kNone;
   double last_fraction = 0.0;
   size_t wavelength_batches = 1;  // SolveMultipleScattering's batches
+  bool accelerated = false;       // with the diffusion correction (acceleration.h)
+  double column_depth = 0.0;      // ScaledColumnDepth, which decides it
 };
 
 // One solve over every wavelength of md (sun and nodes at md's wavelengths); keep_sources:

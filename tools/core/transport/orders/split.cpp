@@ -24,6 +24,7 @@ SplitSettings SplitParts(const OrdersSettings& s) {
   t.truncation_deg = med.truncation_deg;
   t.truncation_min_deg = med.truncation_min_deg > 0.0 && med.truncation_min_deg <= med.truncation_deg ? med.truncation_min_deg : med.truncation_deg;
   t.sun_min_deg = std::max(s.sun_min_deg, s.split_twilight_from_deg);
+  t.dsa_from_tau = 0.0;  // its sun nodes from 88 deg: no diffusion correction (acceleration.h)
   t.sun_deg = SunNodes(t);
   return p;
 }
