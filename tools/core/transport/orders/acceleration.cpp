@@ -98,10 +98,9 @@ DiffusionAcceleration MakeDiffusionAcceleration(const Medium& md, const Nodes& n
   a.ground_loss.resize(nw);
   for (size_t w = 0; w < nw; ++w) a.ground_loss[w] = (1.0 - md.albedo[w]) / (2.0 * (1.0 + md.albedo[w]));
   a.share.assign(a.ns, 0.0);
+  const double end = std::min(nodes.sun_theta_rad.back() / kDeg, kTaperEndDeg);
   for (size_t si = 0; si < a.ns; ++si) {  // kShare, tapered (acceleration.h)
-    const double deg = nodes.sun_theta_rad[si] / kDeg;
-    const double end = std::min(nodes.sun_theta_rad.back() / kDeg, kTaperEndDeg);
-    a.share[si] = kShare * std::clamp((end - deg) / kTaperDeg, 0.0, 1.0);
+    a.share[si] = kShare * std::clamp((end - nodes.sun_theta_rad[si] / kDeg) / kTaperDeg, 0.0, 1.0);
   }
   a.iso.assign(nr * a.ns * nw, 0.0f);
   return a;
@@ -120,8 +119,10 @@ double ScaledColumnDepth(const Medium& md, const Nodes& nodes) {
 void Accelerate(DiffusionAcceleration* a, Table* L) {
   const size_t nr = a->nr, ns = a->ns, nu = a->nu, nphi = a->nphi, nw = a->nw, nd = nu * nphi;
   // L -= the previous correction; the scalar flux of what is left per (radius, sun, wavelength).
+  // A sun node without a share keeps a zero correction: its cells are left as they are.
   std::vector<double> flux(nr * ns * nw, 0.0);
   tbb::parallel_for(size_t{0}, nr * ns, [&](size_t b) {
+    if (!(a->share[b % ns] > 0.0)) return;
     const size_t ri = b / ns;
     const float* ci = &a->iso[b * nw];
     double* fx = &flux[b * nw];
@@ -159,6 +160,7 @@ void Accelerate(DiffusionAcceleration* a, Table* L) {
     }
   });
   tbb::parallel_for(size_t{0}, nr * ns, [&](size_t b) {
+    if (!(a->share[b % ns] > 0.0)) return;
     const float* ci = &a->iso[b * nw];
     for (size_t c = 0; c < nd; ++c) {
       float* v = &(*L)[(b * nd + c) * nw];

@@ -86,7 +86,8 @@ SolveResult SolveMultipleScattering(const AtmosphereModel& m, const Medium& md, 
     };
     const SolveResult r = SolveOrders(m, mb, sb, nb, sb_settings, keep_sources, batch_progress);
     if (b == 0) {
-      out.orders_done = r.orders_done, out.tail = r.tail, out.last_fraction = r.last_fraction, out.accelerated = r.accelerated, out.column_depth = r.column_depth;
+      out.orders_done = r.orders_done, out.tail = r.tail, out.last_fraction = r.last_fraction;
+      out.accelerated = r.accelerated, out.column_depth = r.column_depth;
       out.ms.assign(r.ms.size() / nb.nw * nw, 0.0f);
       if (keep_sources) ZeroTable(&out.jms, r.jms.size() / nb.nw * nw);
     } else if (r.orders_done != out.orders_done || r.tail != out.tail) {
