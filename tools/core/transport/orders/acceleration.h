@@ -22,11 +22,14 @@
 //    the increments grow (x2.3 per order at 93 deg), so the share tapers to 0 over the kTaperDeg
 //    before min(last node, 93 deg): no correction in twilight, where the light runs along the
 //    terminator rather than down through the column;
-//  - the twilight factors of the sun blend from the sources summed over the orders so far
-//    (TransportContext::loglin_means), not from each increment, whose mean sources change sign.
-// Where the sun blend is linear the accelerated sky is the plain series' to 0.1-0.2 %; from 85
-// deg, where the plain series takes each order's own factors, it differs by up to 2.4 % (cloudy5,
-// sun 87 deg), so no preset enables it (OrdersSettings::dsa_from_tau).
+//  - the sun blend linear: the increments' mean sources change sign, so the plain series'
+//    per-order log-linear factors (from 85 deg) do not apply to them.
+// Where the plain series' blend is linear too the accelerated sky is its sky to 0.1-0.2 %. From
+// 85 deg it is not: against the limit of 0.2 deg sun nodes (cloudy5, 77 directions), the plain
+// series is 0.32 / 0.12 % RMS off at sun 87 / 89 deg and the accelerated one 0.53 / 1.15 % (max
+// 2.2 %), the linear blend between 1 deg nodes of a sky that falls steeply; factors from the sums
+// so far are worse (1.44 % at 87 deg), and a share ending at 85 deg with each increment's own
+// factors 30 %. So no preset enables it (OrdersSettings::dsa_from_tau).
 #pragma once
 
 #include <vector>

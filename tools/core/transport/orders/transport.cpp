@@ -64,36 +64,25 @@ void InterpE(const Nodes& nodes, const std::vector<float>& E, double theta_s, fl
   }
 }
 
-std::vector<double> LogLinMeans(const TransportContext& tc, const Table& Jin) {
-  const size_t nw = tc.md->nw, ns = tc.nodes->ns, nr = tc.nodes->radius.size(), nd = tc.nd, first = tc.loglin_first;
-  std::vector<double> g(nr * ns * nw, 0.0);
-  if (first >= ns) return g;
-  tbb::parallel_for(size_t{0}, nr, [&](size_t ri) {
-    for (size_t si = first; si < ns; ++si) {
-      double* gs = &g[(ri * ns + si) * nw];
-      for (size_t i = 0; i < nd; ++i) {
-        const float* v = &Jin[(((ri * ns + si) * nd) + i) * nw];
-        for (size_t w = 0; w < nw; ++w) gs[w] += v[w];
-      }
-    }
-  });
-  return g;
-}
-
 std::vector<float> LogLinFactors(const TransportContext& tc, const Table& Jin) {
-  const size_t nw = tc.md->nw, ns = tc.nodes->ns, nr = tc.nodes->radius.size(), first = tc.loglin_first;
+  const size_t nw = tc.md->nw, ns = tc.nodes->ns, nr = tc.nodes->radius.size(), nd = tc.nd, first = tc.loglin_first;
   std::vector<float> cfac;
   if (first >= ns) return cfac;
-  const std::vector<double> own = tc.loglin_means ? std::vector<double>() : LogLinMeans(tc, Jin);
-  const std::vector<double>& g = tc.loglin_means ? *tc.loglin_means : own;
   cfac.assign(nr * ns * (kLogBins + 1) * nw, 1.0f);
   tbb::parallel_for(size_t{0}, nr, [&](size_t ri) {
+    std::vector<double> g(ns * nw, 0.0);
+    for (size_t si = first; si < ns; ++si) {
+      for (size_t i = 0; i < nd; ++i) {
+        const float* v = &Jin[(((ri * ns + si) * nd) + i) * nw];
+        for (size_t w = 0; w < nw; ++w) g[si * nw + w] += v[w];
+      }
+    }
     for (size_t si = first; si + 1 < ns; ++si) {
       for (size_t b = 0; b <= kLogBins; ++b) {
         const double t = static_cast<double>(b) / kLogBins;
         float* c = &cfac[((ri * ns + si) * (kLogBins + 1) + b) * nw];
         for (size_t w = 0; w < nw; ++w) {
-          const double a = g[(ri * ns + si) * nw + w], bb = g[(ri * ns + si + 1) * nw + w];
+          const double a = g[si * nw + w], bb = g[(si + 1) * nw + w];
           const double lin = (1.0 - t) * a + t * bb;
           c[w] = a > 0.0 && bb > 0.0 && lin > 0.0 ? static_cast<float>(a * std::pow(bb / a, t) / lin) : 1.0f;
         }

@@ -78,9 +78,6 @@ struct TransportContext {
   size_t nd = 0;                // directions per (radius, sun)
   size_t nt = 0;                // steps per table ray
   size_t plane = 0;             // cells per family: ns x nphi
-  // The mean sources the twilight factors C come from (LogLinMeans' layout): null, each order's
-  // own J; set, these (an accelerated solve's sums over its orders so far: acceleration.h).
-  const std::vector<double>* loglin_means = nullptr;
 
   bool Stored(size_t ri) const { return ri < stored_radii; }
   // Where cell (ri, si, k, q)'s position at step `step` is in sun_az: a family's cells at one step
@@ -134,10 +131,6 @@ void TransportSplit(const TransportContext& tc, const Table& Jin, const Table& L
 // corners) and jhi (the upper's) each times its factor at the step's sun interval, interpolated
 // between the kLogBins + 1 tabulated t; the result in jlo.
 std::vector<float> LogLinFactors(const TransportContext& tc, const Table& Jin);
-// The sums over the directions of Jin per radius node, sun node from loglin_first and wavelength,
-// [(ri * ns + si) * nw + w] (the factors' gbar, up to the count of directions; zero below
-// loglin_first), which LogLinFactors takes from tc.loglin_means when that is set.
-std::vector<double> LogLinMeans(const TransportContext& tc, const Table& Jin);
 // The factors at the tabulated bin b0 below position p's t, for the lower radius r0 (*c0) and
 // the one above (*c1), each with bin b0 + 1's row nw floats after it, and t's place *tb between
 // the two bins.
