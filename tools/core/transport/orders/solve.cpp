@@ -340,11 +340,8 @@ SolveResult SolveOrders(const AtmosphereModel& m, const Medium& md, const SunTab
     for (size_t j = 0; j < n_obs; ++j) out.ms[j] += t.L[obs_offset + j] - first[j];
   }
   if (keep_sources) ZeroTable(&out.jms, cells * nw);
-  // An accelerated series' increments are not orders - they change sign where a correction
-  // overshot, and their shape is not the light's - so the sun blend of its sources is linear
-  // throughout: per-increment twilight factors do not apply, and factors from the sums so far
-  // put cloudy5's sky at sun 87 deg 1.44 % RMS off the 0.2 deg sun nodes' limit against 0.53 %
-  // linear (acceleration.h).
+  // An accelerated series' increments are not orders (their mean sources change sign), so the
+  // sun blend of its sources is linear throughout (acceleration.h has the measurements).
   if (accelerate) tc.loglin_first = nodes.ns;
   RatioHistory h;
   std::vector<double> norm_w, ratio_w(nw);
