@@ -9,7 +9,8 @@
 //
 // Per candidate: its radius nodes, its build's wall time, RMS and max |error| against the
 // converged settings and against the path (the reference file <atmosphere>_sun<Z>.csv, if it is
-// of this scene). With --grid, 77 directions (the horizon band and the ground just below it
+// of this scene); with --per-direction also its truncation cones and each direction's signed error
+// ("Truncation cone per component" has those figures). With --grid, 77 directions (the horizon band and the ground just below it
 // among them) and no path; "The twilight split" has those figures:
 //
 //   build/test/bin/bench_orders_nodes --atmosphere clear --sun-zenith-deg 91,95,98,105 --grid
@@ -59,6 +60,7 @@ struct Solve {
   std::vector<std::vector<double>> y;  // per sun zenith, per direction
   double seconds = 0.0;
   std::string nodes;
+  std::string cones;
 };
 
 // The tests' ten directions (SkyAngles), or with grid 77: view zenith 0-89.5 deg and 92 deg (the
@@ -85,6 +87,8 @@ Solve Run(const TestScene& sc, const std::string& overrides, const std::vector<d
   const std::string desc = m->Describe();
   const size_t at = desc.find("radius_nodes: ");
   s.nodes = at == std::string::npos ? "?" : desc.substr(at + 14, desc.find('\n', at) - at - 14);
+  const size_t tr = desc.find("truncation_deg: ");
+  if (tr != std::string::npos) s.cones = desc.substr(tr, desc.find('\n', tr) - tr);
   return s;
 }
 
@@ -95,7 +99,7 @@ int main(int argc, char** argv) {
   std::string atmosphere = "cloudy4", converged;
   std::vector<double> sun_zeniths = {30.0};
   std::vector<std::string> candidates;
-  bool grid = false;
+  bool grid = false, per_direction = false;
   cli.app().add_option("--atmosphere", atmosphere, "Atmosphere (atmospheres/<name>.yaml)");
   cli.app()
       .add_option("--sun-zenith-deg", sun_zeniths, "Sun zenith angles (deg, comma-separated; the path comparison needs one)")
@@ -104,6 +108,7 @@ int main(int argc, char** argv) {
   cli.app().add_option("--converged", converged, "Overrides of the converged solve (key=value,...); empty: none")->required();
   cli.app().add_option("--candidates", candidates, "Overrides of each candidate (key=value,...; \"\" is high itself)")->required();
   cli.app().add_flag("--grid", grid, "77 directions (11 view zeniths x 7 azimuths) instead of the tests' ten; no path comparison");
+  cli.app().add_flag("--per-direction", per_direction, "Also print each direction's signed error against the path (or the converged solve)");
   return cli.Run(argc, argv, [&] {
     const TestScene sc = LoadTestScene(atmosphere);
     const std::vector<std::array<double, 3>> dirs = Directions(grid);
@@ -136,6 +141,16 @@ int main(int argc, char** argv) {
                                                 : std::string("-");
         std::printf("%-40s %6g %6s %8.0f  %-22s %-22s\n", c.empty() ? "(high)" : c.c_str(), sun_zeniths[k], s.nodes.c_str(), s.seconds,
                     fmt::format("{:.3f} % ({:.3f})", 100.0 * std::sqrt(ss / n), 100.0 * mx).c_str(), path.c_str());
+        if (per_direction) {
+          std::printf("  %s\n", s.cones.c_str());
+          std::string line = "  per direction (view zenith/azimuth deg: % off the " + std::string(ref.same_scene ? "path" : "converged solve") + "):";
+          for (size_t d = 0; d < dirs.size(); ++d) {
+            const double base = ref.same_scene ? ref.y[d] : conv.y[k][d];
+            const double vz = std::acos(dirs[d][2]) * 180.0 / M_PI, az = std::atan2(dirs[d][1], dirs[d][0]) * 180.0 / M_PI;
+            line += fmt::format(" {:g}/{:g} {:+.2f}", std::round(vz * 10.0) / 10.0, std::round(az), 100.0 * (s.y[k][d] / base - 1.0));
+          }
+          std::printf("%s\n", line.c_str());
+        }
       }
     }
   });
