@@ -194,8 +194,11 @@ TEST(Presets, OrdersTable) {
   EXPECT_EQ(std::vector<int>({hi.nr, hi.nup, hi.ndn, hi.nphi, hi.nt, hi.nss, hi.fine, hi.sun_nr, hi.kernel_sub}),
             std::vector<int>({16, 24, 12, 36, 40, 96, 512, 192, 4}));
   EXPECT_EQ(hi.tolerance, 3e-4);
-  EXPECT_EQ(hi.truncation_deg, 3.0);
+  EXPECT_EQ(hi.truncation_deg, 10.0);
   EXPECT_EQ(hi.truncation_min_deg, 1.0);
+  // The cone rule's fall per azimuth interval: 10x, 2x for cloud droplets at high (medium.cpp).
+  EXPECT_EQ(std::vector<double>({lo.cone_peak_ratio, me.cone_peak_ratio, hi.cone_peak_ratio}), std::vector<double>({10.0, 10.0, 10.0}));
+  EXPECT_EQ(std::vector<double>({lo.cone_peaked_ratio, me.cone_peaked_ratio, hi.cone_peaked_ratio}), std::vector<double>({10.0, 10.0, 2.0}));
   // The twilight split (transport/orders/split.h): high only.
   EXPECT_EQ(std::vector<double>({hi.split_from_deg, hi.split_width_deg, hi.split_day_to_deg, hi.split_twilight_from_deg}),
             std::vector<double>({90.0, 1.0, 93.0, 88.0}));

@@ -35,8 +35,8 @@ const QualityTable<OrdersSettings>& OrdersPresets() {
       // is split into equal optical-depth pieces, up to 64 nodes (cloudy3: 38 nodes, 0.75 % RMS off
       // its sky with 92 nodes; +2 ... +6.6 % against its 1 % path reference with 16; docs/sky-methods.md
       // "Radius nodes under a cloud").
-      OrdersSettings{.radius_dtau = 0.15, .nup = 24, .ndn = 12, .nphi = 36, .nss = 96, .fine = 512, .truncation_deg = 3.0,
-                     .truncation_min_deg = 1.0, .sun_nr = 192, .kernel_sub = 4, .tolerance = 3e-4,
+      OrdersSettings{.radius_dtau = 0.15, .nup = 24, .ndn = 12, .nphi = 36, .nss = 96, .fine = 512, .truncation_deg = 10.0,
+                     .truncation_min_deg = 1.0, .cone_peaked_ratio = 2.0, .sun_nr = 192, .kernel_sub = 4, .tolerance = 3e-4,
                      .split_from_deg = 90.0, .split_width_deg = 1.0, .split_day_to_deg = 93.0, .split_twilight_from_deg = 88.0},
   }};
   return presets;
@@ -57,6 +57,8 @@ const std::vector<OrdersOverride>& OrdersOverrides() {
       {"radius_max", K::kCount, 3, kMany, 1.0, &S::radius_max},
       {"truncation_deg", K::kScaled, 1, 90, 1.0, &S::truncation_deg},
       {"truncation_min_deg", K::kScaled, 1, 90, 1.0, &S::truncation_min_deg},
+      {"cone_ratio_x10", K::kScaled, 11, 10000, 10.0, &S::cone_peak_ratio},
+      {"cone_peaked_ratio_x10", K::kScaled, 11, 10000, 10.0, &S::cone_peaked_ratio},
       {"normalise", K::kFlag, 0, 1, 1.0, &S::normalise},
       {"tau_cap", K::kScaled, 1, 1000, 1.0, &S::tau_cap},
       {"sun_radius_nodes", K::kCount, 2, kMany, 1.0, &S::sun_nr},

@@ -29,6 +29,10 @@ struct OrdersSettings {
   // (chosen in PrepareMedium; "Truncation cone per component" in docs/sky-methods.md).
   double truncation_deg = 5.0;
   double truncation_min_deg = 0.0;  // 0: the same as truncation_deg (one cone for all)
+  // The cone rule's largest fall of the phase over one azimuth interval outside the cone, and the
+  // same for a component whose phase peaks above 30 sr^-1 (cloud droplets; medium.cpp ChooseCones).
+  double cone_peak_ratio = 10.0;
+  double cone_peaked_ratio = 10.0;
   double tau_cap = 12.0;     // optical depth beyond which a table ray's steps follow distance only
   double rho_cap = 0.98;     // largest ratio of successive orders the geometric tail extrapolates
   // The sun transmittance tables: radius nodes, and the sun-zenith node spacing from 80 to 110 deg.
