@@ -35,6 +35,7 @@
 #include <fmt/format.h>
 
 #include "io/cli.h"
+#include "atmosphere/phase_peak.h"
 #include "io/fileio.h"
 #include "transport/method_scenes.h"
 
@@ -85,14 +86,12 @@ class DeltaTruncatedPhase : public PhaseModel {
   std::vector<std::vector<double>> cdf_;
 };
 
-// The delta-scaled medium of the components peaking above 30 sr^-1 (the others unchanged).
+// The delta-scaled medium of the components peaking above kPeakedPhaseMin (the others unchanged).
 void DeltaScale(AtmosphereModel* m, double cone_deg) {
   const size_t nw = m->wavelengths(), nl = m->levels();
   for (MediumComponent& c : m->components) {
     if (c.phase == nullptr) continue;
-    double peak = 0.0;
-    for (size_t w = 0; w < nw; ++w) peak = std::max(peak, c.phase->Eval(w, 1.0));
-    if (peak <= 30.0) continue;
+    if (PhasePeak(*c.phase, nw) <= kPeakedPhaseMin) continue;
     auto t = std::make_shared<DeltaTruncatedPhase>(c.phase, nw, cone_deg);
     for (size_t l = 0; l < nl; ++l) {
       for (size_t w = 0; w < nw; ++w) c.scattering[l * nw + w] *= 1.0 - t->f(w);

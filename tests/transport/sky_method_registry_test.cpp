@@ -197,7 +197,7 @@ TEST(Presets, OrdersTable) {
   EXPECT_EQ(hi.truncation_deg, 10.0);
   EXPECT_EQ(hi.truncation_min_deg, 1.0);
   // The cone rule's fall per azimuth interval: 10x, 2x for cloud droplets at high (medium.cpp).
-  EXPECT_EQ(std::vector<double>({lo.cone_peak_ratio, me.cone_peak_ratio, hi.cone_peak_ratio}), std::vector<double>({10.0, 10.0, 10.0}));
+  EXPECT_EQ(std::vector<double>({lo.cone_ratio, me.cone_ratio, hi.cone_ratio}), std::vector<double>({10.0, 10.0, 10.0}));
   EXPECT_EQ(std::vector<double>({lo.cone_peaked_ratio, me.cone_peaked_ratio, hi.cone_peaked_ratio}), std::vector<double>({10.0, 10.0, 2.0}));
   // The twilight split (transport/orders/split.h): high only.
   EXPECT_EQ(std::vector<double>({hi.split_from_deg, hi.split_width_deg, hi.split_day_to_deg, hi.split_twilight_from_deg}),

@@ -131,9 +131,7 @@ PathTracer::PathTracer(const AtmosphereModel& model, std::vector<std::array<doub
   for (size_t c = 0; c < nc; ++c) {
     const MediumComponent& comp = model_.components[c];
     if (!comp.phase || *std::max_element(comp.scattering.begin(), comp.scattering.end()) <= 0.0) continue;
-    for (size_t w = 0; w < nw; ++w) {
-      component_peak[c] = std::max({component_peak[c], comp.phase->Eval(w, 1.0), comp.phase->Eval(w, -1.0)});
-    }
+    component_peak[c] = PhasePeak(*comp.phase, nw);
   }
   const double peak = *std::max_element(component_peak.begin(), component_peak.end());
   // The sun-peak guide's mixture: the components whose peak exceeds sun_peak_min, each by its

@@ -54,6 +54,7 @@
 #include <glm/vec3.hpp>
 
 #include "atmosphere/model.h"
+#include "atmosphere/phase_peak.h"
 #include "transport/random.h"
 #include "transport/sun_depth_table.h"
 
@@ -140,7 +141,7 @@ struct PathTracerSettings {
   // intervals of sky-render points at a low sun from 89-91 % to 88-89 % of 150 trials, and the
   // splitting and the roulette were within the heavy tails' run-to-run spread in twilight
   // (docs/sky-render.md "Clouds").
-  double sun_peak_min = 30.0;
+  double sun_peak_min = kPeakedPhaseMin;
   // Splitting and Russian roulette on the weight times the importance of the direction a branch
   // leaves its vertex in (the weight window of Buras & Mayer 2011 with the guide's own density as
   // importance): the importance is max(1, sun_peak_guide x the guide's density there, sr^-1), so

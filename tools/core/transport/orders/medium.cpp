@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "atmosphere/phase_peak.h"
 #include "transport/orders/grid.h"
 
 namespace skybake::orders {
@@ -18,19 +19,16 @@ namespace {
 // integrate is no sharper than its grid resolves. At 550 nm and high's azimuth interval (5 deg with
 // 36 azimuths) the continental aerosol falls 3-4.5x from 1 deg (1 deg cone with R = 10), a 10 um
 // water droplet over 100x from 1 deg, 5-7x from 3 deg and 2x from 6.5 deg. A component whose phase
-// peaks above kPeakedPhase (cloud droplets' diffraction peak, ~1e3 / sr; the aerosols ~10, air
-// 0.12) takes R = cone_peaked_ratio (2 at high, so 6.5 deg for the droplets): inside the cloud
+// peaks above kPeakedPhaseMin (cloud droplets' diffraction peak, ~1e3 / sr; the aerosols ~10, air
+// 0.12; atmosphere/phase_peak.h) takes R = cone_peaked_ratio (2 at high, so 6.5 deg for the droplets): inside the cloud
 // its lobe is scattered again in every order, and with a 3 deg cone the kernel's spread of it left
 // a low sun's sky under cloudy0-2 1.5-3.5 % RMS bright against the path tracer (sun 70 and 85 deg;
 // docs/sky-methods.md "Truncation cone per component").
 void ChooseCones(const OrdersSettings& s, Medium* md) {
-  constexpr double kPeakedPhase = 30.0;  // sr^-1, the path tracer's sun_peak_min (docs/sky-render.md "Clouds")
   const double interval_deg = 180.0 / s.nphi;  // azimuth nodes at cell centres, pi / nphi apart
   md->cone_deg.assign(md->nc, s.truncation_deg);
   for (size_t c = 0; c < md->nc; ++c) {
-    double peak = 0.0;
-    for (size_t w = 0; w < md->nw; ++w) peak = std::max(peak, md->phase[c]->Eval(w, 1.0));
-    const double ratio = peak > kPeakedPhase ? s.cone_peaked_ratio : s.cone_peak_ratio;
+    const double ratio = PhasePeak(*md->phase[c], md->nw) > kPeakedPhaseMin ? s.cone_peaked_ratio : s.cone_ratio;
     for (double th = s.truncation_min_deg; th < s.truncation_deg - 1e-9; th += 0.5) {
       bool smooth = true;
       for (size_t w = 0; w < md->nw && smooth; ++w) {

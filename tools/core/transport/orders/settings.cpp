@@ -57,7 +57,7 @@ const std::vector<OrdersOverride>& OrdersOverrides() {
       {"radius_max", K::kCount, 3, kMany, 1.0, &S::radius_max},
       {"truncation_deg", K::kScaled, 1, 90, 1.0, &S::truncation_deg},
       {"truncation_min_deg", K::kScaled, 1, 90, 1.0, &S::truncation_min_deg},
-      {"cone_ratio_x10", K::kScaled, 11, 10000, 10.0, &S::cone_peak_ratio},
+      {"cone_ratio_x10", K::kScaled, 11, 10000, 10.0, &S::cone_ratio},
       {"cone_peaked_ratio_x10", K::kScaled, 11, 10000, 10.0, &S::cone_peaked_ratio},
       {"normalise", K::kFlag, 0, 1, 1.0, &S::normalise},
       {"tau_cap", K::kScaled, 1, 1000, 1.0, &S::tau_cap},

@@ -31,7 +31,7 @@ struct OrdersSettings {
   double truncation_min_deg = 0.0;  // 0: the same as truncation_deg (one cone for all)
   // The cone rule's largest fall of the phase over one azimuth interval outside the cone, and the
   // same for a component whose phase peaks above 30 sr^-1 (cloud droplets; medium.cpp ChooseCones).
-  double cone_peak_ratio = 10.0;
+  double cone_ratio = 10.0;
   double cone_peaked_ratio = 10.0;
   double tau_cap = 12.0;     // optical depth beyond which a table ray's steps follow distance only
   double rho_cap = 0.98;     // largest ratio of successive orders the geometric tail extrapolates
